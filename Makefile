@@ -1,0 +1,48 @@
+# Front door. `make test` and `make demo` work on a fresh Debian 12 as root:
+# they install the Debian packages that are missing (and only those), configure
+# CMake once, build with -Wall -Wextra -Werror and run.
+
+BUILD      ?= build
+BUILD_TYPE ?= RelWithDebInfo
+JOBS       ?= $(shell nproc)
+PREFIX     ?= /usr/local
+
+# Debian packages the project needs; see README.md for why each is here.
+DEB_PACKAGES := build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev \
+                libmodbus-dev libsystemd-dev libtomlplusplus-dev libcli11-dev \
+                libgtest-dev libgmock-dev libbenchmark-dev libgpiod-dev
+# Ceres is used by the benchmark comparison only, never linked into the daemon.
+BENCH_PACKAGES := libceres-dev
+
+.PHONY: all deps bench-deps configure test demo bench install clean
+
+all: configure
+	cmake --build $(BUILD) -j $(JOBS)
+
+deps:
+	@./tools/install-deps.sh $(DEB_PACKAGES)
+
+bench-deps:
+	@./tools/install-deps.sh $(BENCH_PACKAGES)
+
+$(BUILD)/CMakeCache.txt:
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DCDPR_WERROR=ON
+
+configure: deps $(BUILD)/CMakeCache.txt
+
+test: all
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+demo: all
+	./tools/demo.sh $(BUILD)
+
+bench: bench-deps configure
+	cmake -S . -B $(BUILD) -DCDPR_BENCH=ON
+	cmake --build $(BUILD) -j $(JOBS) --target cdpr-bench
+	$(BUILD)/tools/cdpr-bench
+
+install: all
+	cmake --install $(BUILD) --prefix $(PREFIX)
+
+clean:
+	rm -rf $(BUILD)

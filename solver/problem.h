@@ -1,0 +1,57 @@
+#pragma once
+// The variables and factors of one calibration problem. Owns both; the
+// solver reads and updates variable values in place.
+
+#include <map>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "solver/factor.h"
+#include "solver/keys.h"
+#include "solver/pose.h"
+
+namespace cdpr {
+
+class Problem {
+ public:
+  void add_pose(Key key, const Pose& value);                  // tangent 6, ambient 7
+  void add_vector(Key key, const Eigen::VectorXd& value);     // Euclidean
+  void set_constant(Key key, bool constant = true);           // held fixed by the solver
+  void add_factor(std::unique_ptr<Factor> factor);            // keys must exist
+
+  bool has(Key key) const { return index_.count(key) > 0; }
+  Pose pose(Key key) const;
+  Eigen::VectorXd vector(Key key) const;
+  void set_pose(Key key, const Pose& value);
+  void set_vector(Key key, const Eigen::VectorXd& value);
+
+  struct Variable {
+    Key key;
+    int tangent_dim = 0;
+    int ambient_dim = 0;
+    int ambient_offset = 0;  // into state()
+    bool is_pose = false;
+    bool constant = false;
+  };
+  const std::vector<Variable>& variables() const { return variables_; }
+  int variable_index(Key key) const { return index_.at(key); }
+  const std::vector<std::unique_ptr<Factor>>& factors() const { return factors_; }
+
+  // Flat ambient state of all variables, in variables() order.
+  std::vector<double>& state() { return state_; }
+  const std::vector<double>& state() const { return state_; }
+  // Applies a tangent step to variable v (pose: retract; others: add).
+  void retract(int v, const double* step);
+
+ private:
+  void add_variable(Key key, int tangent_dim, int ambient_dim, bool is_pose, const double* value);
+
+  std::vector<Variable> variables_;
+  std::map<Key, int> index_;
+  std::vector<double> state_;
+  std::vector<std::unique_ptr<Factor>> factors_;
+};
+
+}  // namespace cdpr
