@@ -1,0 +1,41 @@
+#pragma once
+// One calibration from measured static poses: build the factor graph of the
+// paper (Sec. IV) from nominal anchors and the data alone, solve it, and
+// extract anchors and offsets with their 1-sigma from the covariance.
+// Pure numerics: no I/O, no clock; progress is reported through a callback.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "solver/calibration.h"
+#include "solver/levenberg_marquardt.h"
+#include "solver/robot.h"
+#include "solver/sample.h"
+
+namespace cdpr {
+
+enum class CableModelKind { kRigid, kCatenary };
+
+struct CalibrationOptions {
+  CableModelKind cable_model = CableModelKind::kCatenary;
+  double huber_width = 0.0;  // robust loss width in sigma units; <= 0: none
+  int max_iterations = 200;
+  // Sigma [m] of the attachment-height consistency of Eq. (15): a model
+  // identity, not a sensor, so it is held much tighter than the pose noise.
+  double height_sigma_m = 1e-3;
+  std::function<void(const IterationSummary&)> progress;  // may be empty
+};
+
+struct CalibrationResult {
+  bool ok = false;
+  std::string message;      // why it failed, or the solver's termination message
+  Calibration calibration;  // filled when ok (created/robot left to the caller)
+  SolverSummary solver;
+  std::vector<int> rejected_samples;  // sample ids refused before the solve, with reasons in message
+};
+
+CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& samples,
+                            const CalibrationOptions& options);
+
+}  // namespace cdpr
