@@ -1,0 +1,194 @@
+#include "solver/calibrate.h"
+
+#include <cmath>
+#include <memory>
+
+#include "solver/cable_prediction.h"
+#include "solver/initial_guess.h"
+#include "solver/pose_prior_factor.h"
+#include "solver/rigid_encoder_factor.h"
+#include "solver/static_pose_factor.h"
+
+namespace cdpr {
+namespace {
+
+using Anchors = std::array<Eigen::Vector3d, kCableCount>;
+
+Pose measured_pose(const Sample& s) { return {s.position_world, s.world_R_platform}; }
+
+std::string check_inputs(const Robot& robot, const std::vector<Sample>& samples) {
+  if (robot.cable_count() != kCableCount) {
+    return "the solver needs exactly " + std::to_string(kCableCount) + " cables, robot has " +
+           std::to_string(robot.cable_count());
+  }
+  if (robot.reference_cable < 0 || robot.reference_cable >= kCableCount) return "reference cable index out of range";
+  if (samples.size() < 3) return "need at least 3 samples, got " + std::to_string(samples.size());
+  return {};
+}
+
+// Data-driven start for one pose: the paper's force guess refined with the
+// anchors held at their nominal values; falls back to the bare guess.
+struct PoseStart {
+  bool usable = false;
+  Eigen::Vector2d reference_force = Eigen::Vector2d::Zero();
+  std::array<double, kCableCount> lengths{};
+};
+
+PoseStart start_pose(const Robot& robot, const Anchors& anchors, const Sample& sample, const CalibrationOptions& o) {
+  PoseStart start;
+  const Eigen::Vector2d guess = paper_reference_force_guess(robot, anchors, sample);
+  std::optional<Eigen::Vector2d> force = refine_reference_force(robot, anchors, sample, guess, o.height_sigma_m);
+  if (!force) return start;
+  const auto cables = predict_cables(robot, anchors, measured_pose(sample), *force);
+  if (!cables) return start;
+  start.usable = true;
+  start.reference_force = *force;
+  for (int i = 0; i < kCableCount; ++i) start.lengths[i] = (*cables)[i].arc_length_m;
+  return start;
+}
+
+std::array<double, kCableCount> straight_lengths(const Robot& robot, const Anchors& anchors, const Sample& sample) {
+  std::array<double, kCableCount> lengths{};
+  for (int i = 0; i < kCableCount; ++i) {
+    const Eigen::Vector3d b = sample.world_R_platform * robot.winches[i].attachment_platform + sample.position_world;
+    lengths[i] = (b - anchors[i]).norm();
+  }
+  return lengths;
+}
+
+// Unweighted residual statistics at the solution, with plain least squares.
+void fill_fit_rms(const Robot& robot, const std::vector<Sample>& samples, const Problem& problem,
+                  const CalibrationOptions& options, FitSummary& fit) {
+  Anchors anchors;
+  for (int i = 0; i < kCableCount; ++i) anchors[i] = problem.vector(AnchorKey(i));
+  double sum_encoder = 0.0, sum_force = 0.0;
+  int n_encoder = 0, n_force = 0;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const Key pose_key = PoseKey(static_cast<int>(k));
+    const Pose pose = problem.pose(pose_key);
+    if (options.cable_model == CableModelKind::kCatenary) {
+      const Eigen::Vector2d force = problem.vector(ReferenceForceKey(static_cast<int>(k)));
+      const auto cables = predict_cables(robot, anchors, pose, force);
+      if (!cables) continue;
+      for (int i = 0; i < kCableCount; ++i) {
+        const double r = (*cables)[i].arc_length_m + problem.vector(OffsetKey(i))(0) - samples[k].encoder_m[i];
+        sum_encoder += r * r;
+        ++n_encoder;
+      }
+      const double rf = (*cables)[robot.reference_cable].tension_n - samples[k].force_n;
+      sum_force += rf * rf;
+      ++n_force;
+    } else {
+      for (int i = 0; i < kCableCount; ++i) {
+        const Eigen::Vector3d b = pose.transform(robot.winches[i].attachment_platform);
+        const double r = (b - anchors[i]).norm() + problem.vector(OffsetKey(i))(0) - samples[k].encoder_m[i];
+        sum_encoder += r * r;
+        ++n_encoder;
+      }
+    }
+  }
+  fit.rms_encoder_m = n_encoder ? std::sqrt(sum_encoder / n_encoder) : 0.0;
+  fit.rms_force_n = n_force ? std::sqrt(sum_force / n_force) : 0.0;
+}
+
+}  // namespace
+
+CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& all_samples,
+                            const CalibrationOptions& options) {
+  CalibrationResult result;
+  if (std::string why = check_inputs(robot, all_samples); !why.empty()) {
+    result.message = why;
+    return result;
+  }
+  Anchors nominal;
+  for (int i = 0; i < kCableCount; ++i) nominal[i] = robot.winches[i].anchor_world;
+  const Loss loss{options.huber_width};
+  const bool catenary = options.cable_model == CableModelKind::kCatenary;
+
+  // Set-up: a start for every pose; poses the model cannot start from are
+  // refused by id, never dropped silently.
+  std::vector<Sample> samples;
+  std::vector<Eigen::Vector2d> forces;
+  std::vector<std::array<double, kCableCount>> lengths;
+  for (const Sample& sample : all_samples) {
+    if (catenary) {
+      const PoseStart start = start_pose(robot, nominal, sample, options);
+      if (!start.usable) {
+        result.rejected_samples.push_back(sample.id);
+        continue;
+      }
+      forces.push_back(start.reference_force);
+      lengths.push_back(start.lengths);
+    } else {
+      lengths.push_back(straight_lengths(robot, nominal, sample));
+    }
+    samples.push_back(sample);
+  }
+  if (samples.size() < 3) {
+    result.message = "too few usable samples: " + std::to_string(samples.size()) + " of " +
+                     std::to_string(all_samples.size()) + " can be started from the nominal anchors";
+    return result;
+  }
+  const std::array<double, kCableCount> offsets = mean_offsets(samples, lengths);
+
+  Problem problem;
+  for (int i = 0; i < kCableCount; ++i) {
+    problem.add_vector(AnchorKey(i), nominal[i]);
+    problem.add_vector(OffsetKey(i), Eigen::Matrix<double, 1, 1>(offsets[i]));
+  }
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const int pose_index = static_cast<int>(k);
+    problem.add_pose(PoseKey(pose_index), measured_pose(samples[k]));
+    problem.add_factor(std::make_unique<PosePriorFactor>(pose_index, measured_pose(samples[k]),
+                                                         robot.noise.position_m, robot.noise.orientation_rad, loss));
+    if (catenary) {
+      problem.add_vector(ReferenceForceKey(pose_index), forces[k]);
+      problem.add_factor(
+          std::make_unique<StaticPoseFactor>(robot, pose_index, samples[k], options.height_sigma_m, loss));
+    } else {
+      for (int i = 0; i < kCableCount; ++i) {
+        problem.add_factor(std::make_unique<RigidEncoderFactor>(
+            pose_index, i, robot.winches[i].attachment_platform, samples[k].encoder_m[i], robot.noise.encoder_m, loss));
+      }
+    }
+  }
+
+  SolverOptions solver_options;
+  solver_options.max_iterations = options.max_iterations;
+  solver_options.progress = options.progress;
+  LevenbergMarquardt lm(problem, solver_options);
+  result.solver = lm.solve();
+  result.message = result.solver.message;
+  if (!result.solver.usable()) return result;
+
+  std::vector<Key> globals;
+  for (int i = 0; i < kCableCount; ++i) {
+    globals.push_back(AnchorKey(i));
+    globals.push_back(OffsetKey(i));
+  }
+  const Eigen::MatrixXd covariance = lm.covariance(globals);
+
+  Calibration& cal = result.calibration;
+  cal.model = {catenary ? "catenary" : "rigid"};
+  cal.samples = static_cast<int>(samples.size());
+  cal.winches.resize(kCableCount);
+  for (int i = 0; i < kCableCount; ++i) {
+    WinchCalibration& w = cal.winches[i];
+    w.anchor_world = problem.vector(AnchorKey(i));
+    w.offset_m = problem.vector(OffsetKey(i))(0);
+    if (covariance.size() > 0) {
+      const int base = 4 * i;  // anchor (3) then offset (1) per cable, in `globals` order
+      for (int a = 0; a < 3; ++a) w.anchor_sigma(a) = std::sqrt(covariance(base + a, base + a));
+      w.offset_sigma_m = std::sqrt(covariance(base + 3, base + 3));
+    }
+  }
+  cal.fit.cost_initial = result.solver.initial_cost;
+  cal.fit.cost_final = result.solver.final_cost;
+  cal.fit.iterations = result.solver.iterations;
+  fill_fit_rms(robot, samples, problem, options, cal.fit);
+  result.ok = covariance.size() > 0;
+  if (!result.ok) result.message += "; the fit's information matrix is singular: parameters not observable";
+  return result;
+}
+
+}  // namespace cdpr

@@ -1,0 +1,21 @@
+#pragma once
+// Small pieces every factor needs: reading a pose from its ambient storage
+// and applying the robust loss to whitened residuals and Jacobian rows.
+
+#include <span>
+
+#include "solver/loss.h"
+#include "solver/pose.h"
+
+namespace cdpr {
+
+// Ambient pose layout of Problem: x, y, z, qw, qx, qy, qz.
+Pose pose_from_parameters(const double* ambient);
+
+// Scales each whitened residual r_j and row j of every non-null Jacobian
+// block (row-major, residual_dim x block_dims[b]) by sqrt(rho'(r_j^2)) and
+// returns the cost 0.5 * sum rho(r_j^2).
+double apply_loss(const Loss& loss, int residual_dim, double* residual, double* const* jacobians,
+                  std::span<const int> block_dims);
+
+}  // namespace cdpr

@@ -1,0 +1,35 @@
+#pragma once
+// Starting values for a calibration, from the nominal anchors and the data
+// alone (no variable is ever set from ground truth).
+
+#include <array>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "solver/robot.h"
+#include "solver/sample.h"
+
+namespace cdpr {
+
+// Paper Eq. (17)-(18): f_v0 = m g / 4 and f_h0 = f_v0 / tan(alpha), alpha
+// being the elevation of the reference cable's chord seen from its anchor.
+Eigen::Vector2d paper_reference_force_guess(const Robot& robot, const std::array<Eigen::Vector3d, kCableCount>& anchors,
+                                            const Sample& sample);
+
+// Refines (f_h, f_v) of the reference cable at one pose, anchors held fixed,
+// by damped Gauss-Newton on the height (Eq. 15) and force (Eq. 16)
+// residuals, starting from `guess`. Empty when the statics cannot be
+// evaluated near the guess (e.g. a cable would push).
+std::optional<Eigen::Vector2d> refine_reference_force(const Robot& robot,
+                                                      const std::array<Eigen::Vector3d, kCableCount>& anchors,
+                                                      const Sample& sample, const Eigen::Vector2d& guess,
+                                                      double sigma_height_m);
+
+// Encoder offsets as the mean of (reading - modelled length) over the
+// samples; `lengths[k][i]` is the modelled length of cable i at sample k.
+std::array<double, kCableCount> mean_offsets(const std::vector<Sample>& samples,
+                                             const std::vector<std::array<double, kCableCount>>& lengths);
+
+}  // namespace cdpr

@@ -1,0 +1,57 @@
+#pragma once
+// Static equilibrium of the platform on four heavy cables with one reference
+// cable (paper Eq. (5)-(11)): given the pose, the reference cable's force and
+// the anchors, the other three cables' forces follow from the 6x6 system of
+// Eq. (11). Also yields each cable's catenary inputs (span, heights).
+//
+// Jacobians are taken with respect to the local parameter vector
+//   x = [d_p (3), d_theta (3), f_ref (2), anchor_0..3 (12), com_offset (3)]
+// where (d_p, d_theta) is the pose's tangent perturbation (solver/pose.h).
+// Allocation-free.
+
+#include <array>
+
+#include <Eigen/Core>
+
+#include "solver/pose.h"
+#include "solver/robot.h"
+
+namespace cdpr {
+
+inline constexpr int kStaticsParamDim = 23;
+inline constexpr int kStaticsPose = 0;
+inline constexpr int kStaticsForce = 6;
+inline constexpr int kStaticsAnchor = 8;  // + 3 * cable
+inline constexpr int kStaticsCom = 20;
+
+using StaticsRow = Eigen::Matrix<double, 1, kStaticsParamDim>;
+
+// One cable in its vertical plane (paper Sec. III-A).
+struct CableStatics {
+  double f_h = 0.0;           // [N] horizontal force on the platform, towards the anchor
+  double f_v = 0.0;           // [N] vertical force on the platform, up positive
+  double span = 0.0;          // [m] L_i, horizontal anchor-attachment distance
+  double anchor_z = 0.0;      // [m]
+  double attachment_z = 0.0;  // [m] world height of the attachment point
+  StaticsRow d_f_h, d_f_v, d_span, d_anchor_z, d_attachment_z;
+};
+
+struct StaticsInput {
+  Pose world_T_platform;
+  Eigen::Vector2d reference_force = Eigen::Vector2d::Zero();  // (f_h, f_v) [N]
+  std::array<Eigen::Vector3d, kCableCount> anchor_world;
+  Eigen::Vector3d com_offset_platform = Eigen::Vector3d::Zero();  // [m] added to the nominal CoM
+};
+
+enum class StaticsStatus {
+  kOk,
+  kVerticalCable,  // a cable's span is ~0: its vertical plane is undefined
+  kSingular,       // the partition of Eq. (9) is singular at this pose
+};
+
+// Fills `cables` (forces of all four, reference included). Jacobian rows are
+// filled only when `with_jacobian`.
+StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in, bool with_jacobian,
+                                     std::array<CableStatics, kCableCount>& cables);
+
+}  // namespace cdpr
