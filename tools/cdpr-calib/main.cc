@@ -1,0 +1,14 @@
+// cdpr-calib: offline calibration tools for cable-driven parallel robots.
+#include <CLI/CLI.hpp>
+
+#include "solve_command.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"cdpr-calib: offline self-calibration of cable-driven parallel robots with sagging cables"};
+  app.require_subcommand(1);
+  cdpr::tools::SolveArgs solve_args;
+  cdpr::tools::add_solve_command(app, solve_args);
+  CLI11_PARSE(app, argc, argv);
+  if (app.got_subcommand("solve")) return cdpr::tools::run_solve(solve_args);
+  return 1;
+}

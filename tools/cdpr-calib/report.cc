@@ -1,0 +1,65 @@
+#include "report.h"
+
+#include <cmath>
+#include <ctime>
+
+namespace cdpr::tools {
+
+void print_iteration(std::FILE* out, const IterationSummary& it) {
+  std::fprintf(out, "iter %3d  cost %.6e  change %+.3e  |grad| %.3e  |step| %.3e  radius %.2e  %s\n", it.iteration,
+               it.cost, -it.cost_change, it.gradient_max_norm, it.step_norm, it.trust_radius,
+               it.step_accepted ? "accepted" : "rejected");
+}
+
+void print_summary(std::FILE* out, const CalibrationResult& result, const Robot& robot) {
+  const SolverSummary& s = result.solver;
+  std::fprintf(out, "\nsolver: %s\n", result.message.c_str());
+  std::fprintf(out, "cost: %.6e -> %.6e in %d iterations (%d accepted steps)\n", s.initial_cost, s.final_cost,
+               s.iterations, s.successful_steps);
+  if (!result.rejected_samples.empty()) {
+    std::fprintf(out, "rejected samples (the model cannot be started from them):");
+    for (int id : result.rejected_samples) std::fprintf(out, " %d", id);
+    std::fprintf(out, "\n");
+  }
+  if (!result.ok) return;
+  const Calibration& cal = result.calibration;
+  std::fprintf(out, "samples used: %d   model: %s\n", cal.samples, cal.model.empty() ? "?" : cal.model[0].c_str());
+  std::fprintf(out, "rms encoder residual: %.4f m (noise %.4f m)   rms force residual: %.3f N (noise %.3f N)\n",
+               cal.fit.rms_encoder_m, robot.noise.encoder_m, cal.fit.rms_force_n, robot.noise.force_n);
+  std::fprintf(out, "%-6s %32s %28s %18s\n", "cable", "anchor [m]", "anchor sigma [m]", "offset +- sigma [m]");
+  for (std::size_t i = 0; i < cal.winches.size(); ++i) {
+    const WinchCalibration& w = cal.winches[i];
+    std::fprintf(out, "%-6zu %10.4f %10.4f %10.4f   %8.4f %8.4f %8.4f   %9.4f +- %.4f\n", i, w.anchor_world.x(),
+                 w.anchor_world.y(), w.anchor_world.z(), w.anchor_sigma.x(), w.anchor_sigma.y(), w.anchor_sigma.z(),
+                 w.offset_m, w.offset_sigma_m);
+  }
+}
+
+void print_truth_comparison(std::FILE* out, const Calibration& calibration, const Truth& truth) {
+  std::fprintf(out, "\nagainst truth:\n%-6s %14s %14s %14s\n", "cable", "anchor err [m]", "offset err [m]",
+               "err/sigma max");
+  double anchor_sum = 0.0, offset_sum = 0.0;
+  const std::size_t n = std::min(calibration.winches.size(), truth.winches.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const WinchCalibration& w = calibration.winches[i];
+    const Eigen::Vector3d err = w.anchor_world - truth.winches[i].anchor_world;
+    const double offset_err = w.offset_m - truth.winches[i].offset_m;
+    const double normalised = std::max(err.cwiseQuotient(w.anchor_sigma).cwiseAbs().maxCoeff(),
+                                       std::abs(offset_err) / w.offset_sigma_m);
+    std::fprintf(out, "%-6zu %14.4f %14.4f %14.2f\n", i, err.norm(), offset_err, normalised);
+    anchor_sum += err.norm();
+    offset_sum += std::abs(offset_err);
+  }
+  if (n > 0) std::fprintf(out, "mean   %14.4f %14.4f\n", anchor_sum / n, offset_sum / n);
+}
+
+std::string utc_timestamp_now() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return text;
+}
+
+}  // namespace cdpr::tools

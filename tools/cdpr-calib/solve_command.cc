@@ -1,0 +1,85 @@
+#include "solve_command.h"
+
+#include <cstdio>
+#include <fstream>
+
+#include "report.h"
+#include "src/formats/calibration_toml.h"
+#include "src/formats/robot_toml.h"
+#include "src/formats/samples_csv.h"
+
+namespace cdpr::tools {
+
+void add_solve_command(CLI::App& app, SolveArgs& args) {
+  CLI::App* solve = app.add_subcommand("solve", "Calibrate anchors and encoder offsets from measured static poses");
+  solve->add_option("robot", args.robot_path, "robot.toml: nominal geometry, masses and sensor noise")
+      ->required()->check(CLI::ExistingFile);
+  solve->add_option("samples", args.samples_path, "samples.csv: one row per static pose")
+      ->required()->check(CLI::ExistingFile);
+  solve->add_option("-o,--output", args.output_path, "where to write calibration.toml")->capture_default_str();
+  solve->add_option("--model", args.model, "cable model: catenary (heavy sagging cable) or rigid (straight, massless)")
+      ->check(CLI::IsMember({"catenary", "rigid"}))->capture_default_str();
+  solve->add_option("--huber", args.huber_width,
+                    "robust Huber loss width in sigma units (0 = plain least squares)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  solve->add_option("--height-sigma", args.height_sigma_m,
+                    "sigma [m] of the catenary end-height consistency, Eq. (15)")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  solve->add_option("--max-iterations", args.max_iterations, "Levenberg-Marquardt iteration limit")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  solve->add_option("--truth", args.truth_path, "truth.toml of a simulated data set: print the errors against it")
+      ->check(CLI::ExistingFile);
+  solve->add_flag("-q,--quiet", args.quiet, "no per-iteration progress lines");
+}
+
+int run_solve(const SolveArgs& args) {
+  const auto robot = formats::read_robot_toml(args.robot_path);
+  if (!robot) {
+    std::fprintf(stderr, "cdpr-calib: %s\n", robot.error().message().c_str());
+    return 1;
+  }
+  const auto samples = formats::read_samples_csv(args.samples_path, robot->cable_count());
+  if (!samples) {
+    std::fprintf(stderr, "cdpr-calib: %s\n", samples.error().message().c_str());
+    return 1;
+  }
+  std::fprintf(stdout, "robot %s: %d cables, %zu samples, model %s\n", robot->name.c_str(), robot->cable_count(),
+               samples->size(), args.model.c_str());
+
+  CalibrationOptions options;
+  options.cable_model = args.model == "rigid" ? CableModelKind::kRigid : CableModelKind::kCatenary;
+  options.huber_width = args.huber_width;
+  options.height_sigma_m = args.height_sigma_m;
+  options.max_iterations = args.max_iterations;
+  if (!args.quiet) options.progress = [](const IterationSummary& it) { print_iteration(stdout, it); };
+
+  CalibrationResult result = calibrate(*robot, *samples, options);
+  print_summary(stdout, result, *robot);
+  if (!result.ok) {
+    std::fprintf(stderr, "cdpr-calib: calibration failed: %s\n", result.message.c_str());
+    return 2;
+  }
+  result.calibration.robot = robot->name;
+  result.calibration.created = utc_timestamp_now();
+
+  std::ofstream out(args.output_path, std::ios::trunc);
+  out << formats::format_calibration_toml(result.calibration);
+  out.close();
+  if (!out) {
+    std::fprintf(stderr, "cdpr-calib: cannot write %s\n", args.output_path.c_str());
+    return 1;
+  }
+  std::fprintf(stdout, "wrote %s\n", args.output_path.c_str());
+
+  if (!args.truth_path.empty()) {
+    const auto truth = formats::read_truth_toml(args.truth_path);
+    if (!truth) {
+      std::fprintf(stderr, "cdpr-calib: %s\n", truth.error().message().c_str());
+      return 1;
+    }
+    print_truth_comparison(stdout, result.calibration, *truth);
+  }
+  return 0;
+}
+
+}  // namespace cdpr::tools

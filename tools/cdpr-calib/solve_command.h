@@ -1,0 +1,26 @@
+#pragma once
+// `cdpr-calib solve`: robot.toml + samples.csv -> calibration.toml.
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace cdpr::tools {
+
+struct SolveArgs {
+  std::string robot_path;
+  std::string samples_path;
+  std::string output_path = "calibration.toml";
+  std::string truth_path;  // optional: compare with a simulator's truth.toml
+  std::string model = "catenary";
+  double huber_width = 0.0;
+  double height_sigma_m = 1e-3;
+  int max_iterations = 200;
+  bool quiet = false;
+};
+
+void add_solve_command(CLI::App& app, SolveArgs& args);
+// Returns the process exit code: 0 done, 1 bad input, 2 the fit failed.
+int run_solve(const SolveArgs& args);
+
+}  // namespace cdpr::tools

@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# make demo: until the daemon and the virtual robot land, runs the offline
+# pipeline end to end: simulate a large robot, calibrate, compare with truth.
+set -euo pipefail
+build=${1:-build}
+out=$(mktemp -d)
+"$build/tools/cdpr-sim/cdpr-sim" --preset large --poses 35 --seed 7 --anchor-perturbation 10 --out "$out"
+"$build/tools/cdpr-calib/cdpr-calib" solve "$out/robot.toml" "$out/samples.csv" -o "$out/calibration.toml" \
+  --truth "$out/truth.toml"
