@@ -7,6 +7,7 @@
 #include "solver/calibration.h"
 #include "src/formats/expected.h"
 #include "src/formats/format_error.h"
+#include "src/formats/text_file.h"
 
 namespace cdpr::formats {
 
@@ -17,8 +18,5 @@ std::string format_calibration_toml(const Calibration& calibration);
 Expected<Truth, FormatError> parse_truth_toml(std::string_view text, const std::string& source);
 Expected<Truth, FormatError> read_truth_toml(const std::string& path);
 std::string format_truth_toml(const Truth& truth);
-
-// Reads a whole file; the error names the path and errno's reason.
-Expected<std::string, FormatError> read_text_file(const std::string& path);
 
 }  // namespace cdpr::formats
