@@ -45,13 +45,7 @@ void check_reference(TomlReader& reader, const toml::table& cable, std::int64_t 
                   std::to_string(cable_count - 1) + " in [[winch]] order");
 }
 
-}  // namespace
-
-Expected<Robot, FormatError> parse_robot_toml(std::string_view text, const std::string& source) {
-  const auto document = parse_toml_document(text, source);
-  if (!document) return Unexpected{document.error()};
-  const toml::table& root = *document;
-  TomlReader reader(source);
+Robot read_robot(TomlReader& reader, const toml::table& root) {
   Robot robot;
 
   // Later optional tables (pulley geometry, limits, waypoints) are one more
@@ -84,15 +78,17 @@ Expected<Robot, FormatError> parse_robot_toml(std::string_view text, const std::
   robot.noise.force_n = reader.number(noise, "force", "noise", Bound::kPositive);
   robot.noise.position_m = reader.number(noise, "position", "noise", Bound::kPositive);
   robot.noise.orientation_rad = reader.number(noise, "orientation", "noise", Bound::kPositive);
-
-  if (reader.failed()) return Unexpected{reader.error()};
   return robot;
 }
 
+}  // namespace
+
+Expected<Robot, FormatError> parse_robot_toml(std::string_view text, const std::string& source) {
+  return parse_toml<Robot>(text, source, read_robot);
+}
+
 Expected<Robot, FormatError> read_robot_toml(const std::string& path) {
-  const auto text = read_text_file(path);
-  if (!text) return Unexpected{text.error()};
-  return parse_robot_toml(*text, path);
+  return parse_file(path, parse_robot_toml);
 }
 
 std::string format_robot_toml(const Robot& robot) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace cdpr::formats {
 namespace {
@@ -175,6 +176,10 @@ std::optional<double> TomlReader::checked_number(const toml::node& node, const s
     fail(line_of(node), field, "must be > 0, got " + number_text(value));
     return std::nullopt;
   }
+  if (bound == Bound::kNonNegative && !(value >= 0.0)) {
+    fail(line_of(node), field, "must be >= 0, got " + number_text(value));
+    return std::nullopt;
+  }
   return value;
 }
 
@@ -198,6 +203,15 @@ std::int64_t TomlReader::integer(const toml::table& table, std::string_view key,
     return 0;
   }
   return *node->value<std::int64_t>();
+}
+
+int TomlReader::count(const toml::table& table, std::string_view key, std::string_view path) {
+  const std::int64_t value = integer(table, key, path);
+  if (!failed() && (value < 0 || value > std::numeric_limits<int>::max())) {
+    fail(line_of(*table.get(key)), join_key(path, key), "must be a count >= 0, got " + std::to_string(value));
+    return 0;
+  }
+  return static_cast<int>(value);
 }
 
 std::string TomlReader::string(const toml::table& table, std::string_view key, std::string_view path) {

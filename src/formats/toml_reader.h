@@ -33,7 +33,7 @@ struct KeySpec {
 };
 
 // Range a number must lie in; refused values name the bound.
-enum class Bound { kAny, kPositive };
+enum class Bound { kAny, kPositive, kNonNegative };
 
 // Parses TOML text; a syntax error becomes a FormatError with toml++'s line.
 Expected<toml::table, FormatError> parse_toml_document(std::string_view text, const std::string& source);
@@ -66,6 +66,8 @@ class TomlReader {
   std::optional<double> optional_number(const toml::table& table, std::string_view key, std::string_view path,
                                         Bound bound = Bound::kAny);
   std::int64_t integer(const toml::table& table, std::string_view key, std::string_view path);
+  // A non-negative integer that fits an int (counts: samples, iterations).
+  int count(const toml::table& table, std::string_view key, std::string_view path);
   std::string string(const toml::table& table, std::string_view key, std::string_view path);
   std::vector<std::string> strings(const toml::table& table, std::string_view key, std::string_view path);
   // Exactly three finite numbers, each inside `bound`.
@@ -87,5 +89,17 @@ class TomlReader {
   std::string source_;
   std::optional<FormatError> error_;
 };
+
+// The frame of every TOML parser: parse the text, let `read(reader, root)`
+// build the value through `reader`, and return it or the first problem.
+template <class T, class Read>
+Expected<T, FormatError> parse_toml(std::string_view text, const std::string& source, Read read) {
+  const auto document = parse_toml_document(text, source);
+  if (!document) return Unexpected{document.error()};
+  TomlReader reader(source);
+  T value = read(reader, *document);
+  if (reader.failed()) return Unexpected{reader.error()};
+  return value;
+}
 
 }  // namespace cdpr::formats

@@ -1,10 +1,11 @@
 #include "src/formats/toml_writer.h"
 
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 
 #include <toml++/toml.h>
+
+#include "src/formats/number_text.h"
 
 namespace cdpr::formats {
 namespace {
@@ -23,9 +24,7 @@ std::string toml_array(const std::vector<T>& values, Format format) {
 std::string toml_number(double value) {
   if (std::isnan(value)) return "nan";
   if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
-  char text[32];
-  const auto [end, ec] = std::to_chars(text, text + sizeof text, value);  // shortest round-trip form
-  std::string result(text, end);
+  std::string result = shortest_text(value);
   if (result.find_first_of(".e") == std::string::npos) result += ".0";
   return result;
 }

@@ -1,0 +1,47 @@
+// truth.toml (FORMATS.md): the ground truth a simulator wrote next to its
+// data set; read only by evaluation, never by calibration.
+#include "src/formats/calibration_toml.h"
+#include "src/formats/effects_toml.h"
+#include "src/formats/toml_reader.h"
+#include "src/formats/toml_writer.h"
+
+namespace cdpr::formats {
+namespace {
+
+Truth read_truth(TomlReader& reader, const toml::table& root) {
+  Truth truth;
+  reader.check_keys(root, "", {{"winch", Presence::kRequired}, {"effects", Presence::kOptional}});
+  for (const toml::table* table : reader.tables(root, "winch", "")) {
+    const std::string path = "winch[" + std::to_string(truth.winches.size()) + "]";
+    reader.check_keys(*table, path, {{"anchor", Presence::kRequired}, {"offset", Presence::kRequired}});
+    WinchTruth& winch = truth.winches.emplace_back();
+    winch.anchor_world = reader.vector3(*table, "anchor", path);
+    winch.offset_m = reader.number(*table, "offset", path);
+  }
+  truth.effects = read_effects(reader, root);
+  return truth;
+}
+
+}  // namespace
+
+Expected<Truth, FormatError> parse_truth_toml(std::string_view text, const std::string& source) {
+  return parse_toml<Truth>(text, source, read_truth);
+}
+
+Expected<Truth, FormatError> read_truth_toml(const std::string& path) {
+  return parse_file(path, parse_truth_toml);
+}
+
+std::string format_truth_toml(const Truth& truth) {
+  std::string out;
+  for (std::size_t i = 0; i < truth.winches.size(); ++i) {
+    if (i > 0) out += '\n';
+    append_line(out, "[[winch]]", "cable " + std::to_string(i));
+    append_line(out, "anchor = " + toml_vector3(truth.winches[i].anchor_world), "m, true pulley exit point");
+    append_line(out, "offset = " + toml_number(truth.winches[i].offset_m), "m, true encoder offset");
+  }
+  append_effects(out, truth.effects);
+  return out;
+}
+
+}  // namespace cdpr::formats
