@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <limits>
 
 namespace cdpr::formats {
@@ -60,9 +61,9 @@ std::string unknown_key_reason(const toml::node& node, std::string_view key, std
   }
   if (nearest != nullptr) return reason + " (did you mean '" + std::string(nearest->name) + "'?)";
   if (keys.size() == 0) return reason + " (this table takes no keys)";
-  reason += " (allowed here:";
-  for (const KeySpec& spec : keys) reason += " " + std::string(spec.name);
-  return reason + ")";
+  reason += " (allowed here: ";
+  for (const KeySpec& spec : keys) reason += std::string(spec.name) + (&spec == std::prev(keys.end()) ? ")" : ", ");
+  return reason;
 }
 
 // RFC 3339 text of an offset date-time, the form calibration.toml writes.
@@ -82,6 +83,12 @@ std::string rfc3339(const toml::date_time& dt) {
   const int magnitude = std::abs(offset);
   n = std::snprintf(text, sizeof text, "%c%02d:%02d", offset < 0 ? '-' : '+', magnitude / 60, magnitude % 60);
   return result + std::string(text, static_cast<std::size_t>(n));
+}
+
+// Where to point for a key missing from `table`: its header line, or no line
+// (the whole file) for the root table.
+int missing_key_line(const toml::table& table, std::string_view path) {
+  return path.empty() ? 0 : TomlReader::line_of(table);
 }
 
 }  // namespace
@@ -122,14 +129,14 @@ void TomlReader::check_keys(const toml::table& table, std::string_view path, std
   }
   if (!missing.empty()) {
     const bool several = missing.find(',') != std::string::npos;
-    fail(line_of(table), missing, several ? "missing required keys" : "missing required key");
+    fail(missing_key_line(table, path), missing, several ? "missing required keys" : "missing required key");
   }
 }
 
 const toml::node* TomlReader::require(const toml::table& table, std::string_view key, std::string_view path) {
   if (failed()) return nullptr;
   const toml::node* node = table.get(key);
-  if (node == nullptr) fail(line_of(table), join_key(path, key), "missing required key");
+  if (node == nullptr) fail(missing_key_line(table, path), join_key(path, key), "missing required key");
   return node;
 }
 
@@ -138,7 +145,9 @@ const toml::table& TomlReader::table(const toml::table& parent, std::string_view
   if (failed()) return empty_table();
   const toml::node* node = parent.get(key);
   if (node == nullptr) {
-    if (presence == Presence::kRequired) fail(line_of(parent), join_key(path, key), "missing required table");
+    if (presence == Presence::kRequired) {
+      fail(missing_key_line(parent, path), join_key(path, key), "missing required table");
+    }
     return empty_table();
   }
   if (!node->is_table()) {
