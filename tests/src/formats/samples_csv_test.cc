@@ -1,0 +1,195 @@
+#include "src/formats/samples_csv.h"
+
+#include <cctype>
+#include <cmath>
+#include <string>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+namespace cdpr::formats {
+namespace {
+
+// The samples.csv example of FORMATS.md plus a second row.
+const std::string kExample =
+    "# lines starting with '#' are comments\n"
+    "sample,x,y,z,qw,qx,qy,qz,enc0,enc1,enc2,enc3,force\n"
+    "0,112.31,104.92,12.07,0.9998,0.0031,-0.0152,0.0004,171.233,182.904,166.118,190.451,702.4\n"
+    "1,80.5,90.25,10.5,1,0,0,0,150.5,160.25,170.125,180.0625,650\n";
+
+FormatError parse_error(const std::string& text) {
+  const auto samples = parse_samples_csv(text, "samples.csv", kCableCount);
+  EXPECT_FALSE(samples.has_value());
+  return samples ? FormatError{} : samples.error();
+}
+
+// kExample with the first occurrence of `from` replaced by `to`.
+std::string example_with(const std::string& from, const std::string& to) {
+  std::string text = kExample;
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+TEST(SamplesCsv, ExampleOfFormatsMdParses) {
+  // GIVEN the documented example
+  // WHEN it is parsed
+  const auto samples = parse_samples_csv(kExample, "samples.csv", kCableCount);
+  // THEN each row becomes a sample with its values in place
+  ASSERT_TRUE(samples.has_value()) << samples.error().message();
+  ASSERT_EQ(samples->size(), 2u);
+  const Sample& s = (*samples)[0];
+  EXPECT_EQ(s.id, 0);
+  EXPECT_EQ(s.position_world, Eigen::Vector3d(112.31, 104.92, 12.07));
+  EXPECT_EQ(s.encoder_m[0], 171.233);
+  EXPECT_EQ(s.encoder_m[3], 190.451);
+  EXPECT_EQ(s.force_n, 702.4);
+  // (the quaternion is normalised: its norm is 0.99992, inside the tolerance)
+  EXPECT_NEAR(s.world_R_platform.norm(), 1.0, 1e-15);
+  const double norm = std::sqrt(0.9998 * 0.9998 + 0.0031 * 0.0031 + 0.0152 * 0.0152 + 0.0004 * 0.0004);
+  EXPECT_NEAR(s.world_R_platform.y(), -0.0152 / norm, 1e-15);
+  EXPECT_EQ((*samples)[1].id, 1);
+  EXPECT_EQ((*samples)[1].world_R_platform.w(), 1.0);
+}
+
+TEST(SamplesCsv, ColumnsAreMatchedByNameWithSpacesAndCrlf) {
+  // GIVEN shuffled columns, blanks around fields, CRLF line endings and blank lines
+  const std::string text =
+      "\r\n# exported by a spreadsheet\r\n"
+      " force , enc3, enc2 ,enc1,enc0,qz,qy,qx,qw,z,y,x,sample \r\n"
+      "\r\n"
+      "702.4, 190.451,166.118,182.904,171.233,0,0,0,1,12.07,104.92,112.31, 7\r\n";
+  // WHEN it is parsed
+  const auto samples = parse_samples_csv(text, "samples.csv", kCableCount);
+  // THEN every value lands in its named field
+  ASSERT_TRUE(samples.has_value()) << samples.error().message();
+  ASSERT_EQ(samples->size(), 1u);
+  const Sample& s = (*samples)[0];
+  EXPECT_EQ(s.id, 7);
+  EXPECT_EQ(s.position_world, Eigen::Vector3d(112.31, 104.92, 12.07));
+  EXPECT_EQ(s.world_R_platform.coeffs(), Eigen::Quaterniond::Identity().coeffs());
+  EXPECT_EQ(s.encoder_m[0], 171.233);
+  EXPECT_EQ(s.encoder_m[1], 182.904);
+  EXPECT_EQ(s.encoder_m[2], 166.118);
+  EXPECT_EQ(s.encoder_m[3], 190.451);
+  EXPECT_EQ(s.force_n, 702.4);
+}
+
+struct BadInput {
+  const char* what;
+  const char* from;
+  const char* to;
+  int line;
+  const char* field;
+  const char* reason_part;
+};
+
+class SamplesCsvBadInput : public testing::TestWithParam<BadInput> {};
+
+TEST_P(SamplesCsvBadInput, IsRefusedWithLineColumnAndReason) {
+  // GIVEN the example with one thing spoilt
+  const BadInput& bad = GetParam();
+  const std::string text = example_with(bad.from, bad.to);
+  // WHEN it is parsed
+  const FormatError error = parse_error(text);
+  // THEN the error names the file line, the column and why
+  EXPECT_EQ(error.file, "samples.csv");
+  EXPECT_EQ(error.line, bad.line) << bad.what;
+  EXPECT_EQ(error.field, bad.field) << bad.what;
+  EXPECT_NE(error.reason.find(bad.reason_part), std::string::npos) << bad.what << ": " << error.reason;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, SamplesCsvBadInput,
+    testing::Values(
+        BadInput{"nan", "171.233", "nan", 3, "enc0", "not a finite number: 'nan'"},
+        BadInput{"inf", "702.4", "-inf", 3, "force", "not a finite number"},
+        BadInput{"empty value", ",12.07,", ",,", 3, "z", "missing value"},
+        BadInput{"non-numeric", "104.92", "1o4.92", 3, "y", "not a number: '1o4.92'"},
+        BadInput{"decimal comma", "104.92", "104,92", 3, "", "row has 14 values but the header has 13 columns"},
+        BadInput{"text value", "150.5", "abc", 4, "enc0", "not a number: 'abc'"},
+        BadInput{"trailing junk", "150.5", "150.5m", 4, "enc0", "not a number: '150.5m'"},
+        BadInput{"short row", ",650\n", "\n", 4, "force", "row has 12 values but the header has 13 columns"},
+        BadInput{"long row", ",650\n", ",650,1\n", 4, "", "row has 14 values"},
+        BadInput{"fractional id", "\n1,", "\n1.5,", 4, "sample", "sample id must be an integer, got '1.5'"},
+        BadInput{"duplicate id", "\n1,", "\n0,", 4, "sample", "duplicate sample id 0 (first on line 3)"},
+        BadInput{"bad quaternion", "1,0,0,0,150.5", "0.93,0,0,0,150.5", 4, "qw..qz", "quaternion norm 0.93 is not 1"},
+        BadInput{"unknown column", "enc3", "enc4", 2, "enc4", "unknown column 12"},
+        BadInput{"misspelt column", "force", "forse", 2, "forse", "unknown column"},
+        BadInput{"duplicate column", ",y,", ",x,", 2, "x", "duplicate column (columns 2 and 3)"},
+        BadInput{"missing column", ",enc2", "", 2, "enc2", "missing column"},
+        BadInput{"empty column name", "qz,", "qz,,", 2, "", "column 9 has no name"}),
+    [](const testing::TestParamInfo<BadInput>& info) {
+      std::string name = info.param.what;
+      for (char& c : name) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+      return name;
+    });
+
+TEST(SamplesCsv, QuaternionJustInsideToleranceIsNormalised) {
+  // GIVEN a quaternion whose norm is 1.0009
+  const std::string text = example_with("1,0,0,0,150.5", "1.0009,0,0,0,150.5");
+  // WHEN it is parsed
+  const auto samples = parse_samples_csv(text, "samples.csv", kCableCount);
+  // THEN it is accepted as a unit quaternion
+  ASSERT_TRUE(samples.has_value()) << samples.error().message();
+  EXPECT_EQ((*samples)[1].world_R_platform.w(), 1.0);
+}
+
+TEST(SamplesCsv, HeaderWithoutRowsIsRefused) {
+  // GIVEN only comments and the header
+  const std::string text = kExample.substr(0, kExample.find("\n0,") + 1);
+  // WHEN it is parsed
+  const FormatError error = parse_error(text);
+  // THEN it says there are no data rows, at the header's line
+  EXPECT_EQ(error.reason, "no data rows");
+  EXPECT_EQ(error.line, 2);
+}
+
+TEST(SamplesCsv, EmptyFileIsRefused) {
+  // GIVEN only a comment
+  // WHEN it is parsed
+  const FormatError error = parse_error("# nothing here\n");
+  // THEN it asks for the header and spells it out
+  EXPECT_NE(error.reason.find("no header line"), std::string::npos) << error.reason;
+  EXPECT_NE(error.reason.find("sample,x,y,z,qw,qx,qy,qz,enc0,enc1,enc2,enc3,force"), std::string::npos);
+}
+
+TEST(SamplesCsv, OtherCableCountsAreRefused) {
+  // GIVEN a request for three cables
+  // WHEN the example is parsed
+  const auto samples = parse_samples_csv(kExample, "samples.csv", 3);
+  // THEN it is refused naming the counts
+  ASSERT_FALSE(samples.has_value());
+  EXPECT_NE(samples.error().reason.find("3 cables"), std::string::npos) << samples.error().reason;
+}
+
+TEST(SamplesCsv, FormatThenParseGivesTheSameSamples) {
+  // GIVEN samples with values that need all 17 digits and rotated orientations
+  std::vector<Sample> samples;
+  for (int k = 0; k < 5; ++k) {
+    Sample s;
+    s.id = 10 * k - 3;
+    s.position_world = Eigen::Vector3d(100.0 / 3.0 + k, -0.1 * k, 1e-300 + k);
+    s.world_R_platform = Eigen::Quaterniond(Eigen::AngleAxisd(0.1 * k + 0.05, Eigen::Vector3d(1, 2, 3).normalized()));
+    for (int i = 0; i < kCableCount; ++i) s.encoder_m[i] = 150.0 + std::sqrt(2.0 + i + k);
+    s.force_n = 700.0 / 7.1 + k;
+    samples.push_back(s);
+  }
+  // WHEN they are formatted and parsed again
+  const std::string text = format_samples_csv(samples);
+  const auto again = parse_samples_csv(text, "written.csv", kCableCount);
+  // THEN every value is bit-identical
+  ASSERT_TRUE(again.has_value()) << again.error().message() << "\n" << text;
+  ASSERT_EQ(again->size(), samples.size());
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    EXPECT_EQ((*again)[k].id, samples[k].id);
+    EXPECT_EQ((*again)[k].position_world, samples[k].position_world);
+    EXPECT_EQ((*again)[k].world_R_platform.coeffs(), samples[k].world_R_platform.coeffs());
+    EXPECT_EQ((*again)[k].encoder_m, samples[k].encoder_m);
+    EXPECT_EQ((*again)[k].force_n, samples[k].force_n);
+  }
+}
+
+}  // namespace
+}  // namespace cdpr::formats
