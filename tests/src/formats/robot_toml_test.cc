@@ -1,11 +1,11 @@
 #include "src/formats/robot_toml.h"
 
-#include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <string>
 
 #include <gtest/gtest.h>
+
+#include "format_test_support.h"
 
 namespace cdpr::formats {
 namespace {
@@ -47,21 +47,10 @@ position = 0.005                   # m   (pose translation)
 orientation = 0.01                 # rad (pose rotation)
 )";
 
-// kExample with the first occurrence of `from` replaced by `to`.
-std::string example_with(const std::string& from, const std::string& to) {
-  std::string text = kExample;
-  const std::size_t at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  if (at != std::string::npos) text.replace(at, from.size(), to);
-  return text;
-}
+using test::BadEdit;
+using test::line_of;
 
-// 1-based line of the first occurrence of `needle` in `text`.
-int line_of(const std::string& text, const std::string& needle) {
-  const std::size_t at = text.find(needle);
-  EXPECT_NE(at, std::string::npos) << needle;
-  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
-}
+std::string example_with(const std::string& from, const std::string& to) { return test::replaced(kExample, from, to); }
 
 FormatError parse_error(const std::string& text) {
   const auto robot = parse_robot_toml(text, "robot.toml");
@@ -170,58 +159,44 @@ TEST(RobotToml, OptionalKeysHaveTheirDefaultsOrValues) {
   EXPECT_EQ(*robot->axial_stiffness_n, 2.0e6);
 }
 
-struct BadValue {
-  const char* what;
-  const char* from;
-  const char* to;
-  const char* field;
-  const char* reason_part;
-};
-
-class RobotTomlBadValue : public testing::TestWithParam<BadValue> {};
+class RobotTomlBadValue : public testing::TestWithParam<BadEdit> {};
 
 TEST_P(RobotTomlBadValue, IsRefusedWithLineKeyAndReason) {
   // GIVEN the example with one value spoilt
-  const BadValue& bad = GetParam();
+  const BadEdit& bad = GetParam();
   const std::string text = example_with(bad.from, bad.to);
   // WHEN it is parsed
   const FormatError error = parse_error(text);
   // THEN the error names the key, the line of the spoilt value and why
-  EXPECT_EQ(error.field, bad.field) << bad.what;
-  EXPECT_EQ(error.line, line_of(text, bad.to)) << bad.what;
-  EXPECT_NE(error.reason.find(bad.reason_part), std::string::npos) << bad.what << ": " << error.reason;
+  test::expect_refusal(error, bad, text);
 }
 
 INSTANTIATE_TEST_SUITE_P(
     Cases, RobotTomlBadValue,
     testing::Values(
-        BadValue{"negative mass", "mass = 34.0", "mass = -34.0", "platform.mass", "must be > 0, got -34"},
-        BadValue{"zero density", "linear_density = 0.0724", "linear_density = 0", "cable.linear_density",
+        BadEdit{"negative mass", "mass = 34.0", "mass = -34.0", "platform.mass", "must be > 0, got -34"},
+        BadEdit{"zero density", "linear_density = 0.0724", "linear_density = 0", "cable.linear_density",
                  "must be > 0"},
-        BadValue{"zero sigma", "force = 5.0", "force = 0.0", "noise.force", "must be > 0"},
-        BadValue{"nan gravity", "gravity = 9.81", "gravity = nan", "gravity", "finite"},
-        BadValue{"inf anchor", "anchor = [0.0, 0.0, 50.0]", "anchor = [0.0, inf, 50.0]", "winch[0].anchor[1]",
+        BadEdit{"zero sigma", "force = 5.0", "force = 0.0", "noise.force", "must be > 0"},
+        BadEdit{"nan gravity", "gravity = 9.81", "gravity = nan", "gravity", "finite"},
+        BadEdit{"inf anchor", "anchor = [0.0, 0.0, 50.0]", "anchor = [0.0, inf, 50.0]", "winch[0].anchor[1]",
                  "finite"},
-        BadValue{"non-numeric", "mass = 34.0", "mass = \"heavy\"", "platform.mass", "expected a number, got a string"},
-        BadValue{"short array", "center_of_mass = [0.0, 0.0, 0.0]", "center_of_mass = [0.0, 0.0]",
+        BadEdit{"non-numeric", "mass = 34.0", "mass = \"heavy\"", "platform.mass", "expected a number, got a string"},
+        BadEdit{"short array", "center_of_mass = [0.0, 0.0, 0.0]", "center_of_mass = [0.0, 0.0]",
                  "platform.center_of_mass", "expected an array of 3 numbers [x, y, z], got an array of 2"},
-        BadValue{"long array", "attachment = [-0.1, 0.1, 0.0]", "attachment = [-0.1, 0.1, 0.0, 1.0]",
+        BadEdit{"long array", "attachment = [-0.1, 0.1, 0.0]", "attachment = [-0.1, 0.1, 0.0, 1.0]",
                  "winch[1].attachment", "got an array of 4"},
-        BadValue{"scalar for array", "anchor = [200.0, 0.0, 50.0]", "anchor = 200.0", "winch[1].anchor",
+        BadEdit{"scalar for array", "anchor = [200.0, 0.0, 50.0]", "anchor = 200.0", "winch[1].anchor",
                  "got a number"},
-        BadValue{"string in array", "anchor = [0.0, 200.0, 50.0]", "anchor = [0.0, \"200\", 50.0]",
+        BadEdit{"string in array", "anchor = [0.0, 200.0, 50.0]", "anchor = [0.0, \"200\", 50.0]",
                  "winch[3].anchor[1]", "expected a number"},
-        BadValue{"reference past the end", "reference = 0", "reference = 4", "cable.reference",
+        BadEdit{"reference past the end", "reference = 0", "reference = 4", "cable.reference",
                  "cable index 4 does not exist; cables are numbered 0..3"},
-        BadValue{"negative reference", "reference = 0", "reference = -1", "cable.reference", "cable index -1"},
-        BadValue{"fractional reference", "reference = 0", "reference = 0.5", "cable.reference",
+        BadEdit{"negative reference", "reference = 0", "reference = -1", "cable.reference", "cable index -1"},
+        BadEdit{"fractional reference", "reference = 0", "reference = 0.5", "cable.reference",
                  "expected an integer"},
-        BadValue{"name not text", "name = \"large\"", "name = 7", "name", "expected a string"}),
-    [](const testing::TestParamInfo<BadValue>& info) {
-      std::string name = info.param.what;
-      std::replace_if(name.begin(), name.end(), [](char c) { return !std::isalnum(static_cast<unsigned char>(c)); }, '_');
-      return name;
-    });
+        BadEdit{"name not text", "name = \"large\"", "name = 7", "name", "expected a string"}),
+    test::case_name);
 
 TEST(RobotToml, WrongWinchCountIsRefusedWithTheCount) {
   // GIVEN only three [[winch]] tables

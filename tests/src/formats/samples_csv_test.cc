@@ -1,11 +1,12 @@
 #include "src/formats/samples_csv.h"
 
-#include <cctype>
 #include <cmath>
 #include <string>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
+
+#include "format_test_support.h"
 
 namespace cdpr::formats {
 namespace {
@@ -23,14 +24,9 @@ FormatError parse_error(const std::string& text) {
   return samples ? FormatError{} : samples.error();
 }
 
-// kExample with the first occurrence of `from` replaced by `to`.
-std::string example_with(const std::string& from, const std::string& to) {
-  std::string text = kExample;
-  const std::size_t at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  if (at != std::string::npos) text.replace(at, from.size(), to);
-  return text;
-}
+using test::BadEdit;
+
+std::string example_with(const std::string& from, const std::string& to) { return test::replaced(kExample, from, to); }
 
 TEST(SamplesCsv, ExampleOfFormatsMdParses) {
   // GIVEN the documented example
@@ -76,55 +72,40 @@ TEST(SamplesCsv, ColumnsAreMatchedByNameWithSpacesAndCrlf) {
   EXPECT_EQ(s.force_n, 702.4);
 }
 
-struct BadInput {
-  const char* what;
-  const char* from;
-  const char* to;
-  int line;
-  const char* field;
-  const char* reason_part;
-};
-
-class SamplesCsvBadInput : public testing::TestWithParam<BadInput> {};
+class SamplesCsvBadInput : public testing::TestWithParam<BadEdit> {};
 
 TEST_P(SamplesCsvBadInput, IsRefusedWithLineColumnAndReason) {
   // GIVEN the example with one thing spoilt
-  const BadInput& bad = GetParam();
+  const BadEdit& bad = GetParam();
   const std::string text = example_with(bad.from, bad.to);
   // WHEN it is parsed
   const FormatError error = parse_error(text);
   // THEN the error names the file line, the column and why
   EXPECT_EQ(error.file, "samples.csv");
-  EXPECT_EQ(error.line, bad.line) << bad.what;
-  EXPECT_EQ(error.field, bad.field) << bad.what;
-  EXPECT_NE(error.reason.find(bad.reason_part), std::string::npos) << bad.what << ": " << error.reason;
+  test::expect_refusal(error, bad, text);
 }
 
 INSTANTIATE_TEST_SUITE_P(
     Cases, SamplesCsvBadInput,
     testing::Values(
-        BadInput{"nan", "171.233", "nan", 3, "enc0", "not a finite number: 'nan'"},
-        BadInput{"inf", "702.4", "-inf", 3, "force", "not a finite number"},
-        BadInput{"empty value", ",12.07,", ",,", 3, "z", "missing value"},
-        BadInput{"non-numeric", "104.92", "1o4.92", 3, "y", "not a number: '1o4.92'"},
-        BadInput{"decimal comma", "104.92", "104,92", 3, "", "row has 14 values but the header has 13 columns"},
-        BadInput{"text value", "150.5", "abc", 4, "enc0", "not a number: 'abc'"},
-        BadInput{"trailing junk", "150.5", "150.5m", 4, "enc0", "not a number: '150.5m'"},
-        BadInput{"short row", ",650\n", "\n", 4, "force", "row has 12 values but the header has 13 columns"},
-        BadInput{"long row", ",650\n", ",650,1\n", 4, "", "row has 14 values"},
-        BadInput{"fractional id", "\n1,", "\n1.5,", 4, "sample", "sample id must be an integer, got '1.5'"},
-        BadInput{"duplicate id", "\n1,", "\n0,", 4, "sample", "duplicate sample id 0 (first on line 3)"},
-        BadInput{"bad quaternion", "1,0,0,0,150.5", "0.93,0,0,0,150.5", 4, "qw..qz", "quaternion norm 0.93 is not 1"},
-        BadInput{"unknown column", "enc3", "enc4", 2, "enc4", "unknown column 12"},
-        BadInput{"misspelt column", "force", "forse", 2, "forse", "unknown column"},
-        BadInput{"duplicate column", ",y,", ",x,", 2, "x", "duplicate column (columns 2 and 3)"},
-        BadInput{"missing column", ",enc2", "", 2, "enc2", "missing column"},
-        BadInput{"empty column name", "qz,", "qz,,", 2, "", "column 9 has no name"}),
-    [](const testing::TestParamInfo<BadInput>& info) {
-      std::string name = info.param.what;
-      for (char& c : name) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-      return name;
-    });
+        BadEdit{"nan", "171.233", "nan", "enc0", "not a finite number: 'nan'", 3},
+        BadEdit{"inf", "702.4", "-inf", "force", "not a finite number", 3},
+        BadEdit{"empty value", ",12.07,", ",,", "z", "missing value", 3},
+        BadEdit{"non-numeric", "104.92", "1o4.92", "y", "not a number: '1o4.92'", 3},
+        BadEdit{"decimal comma", "104.92", "104,92", "", "row has 14 values but the header has 13 columns", 3},
+        BadEdit{"text value", "150.5", "abc", "enc0", "not a number: 'abc'", 4},
+        BadEdit{"trailing junk", "150.5", "150.5m", "enc0", "not a number: '150.5m'", 4},
+        BadEdit{"short row", ",650\n", "\n", "force", "row has 12 values but the header has 13 columns", 4},
+        BadEdit{"long row", ",650\n", ",650,1\n", "", "row has 14 values", 4},
+        BadEdit{"fractional id", "\n1,", "\n1.5,", "sample", "sample id must be an integer, got '1.5'", 4},
+        BadEdit{"duplicate id", "\n1,", "\n0,", "sample", "duplicate sample id 0 (first on line 3)", 4},
+        BadEdit{"bad quaternion", "1,0,0,0,150.5", "0.93,0,0,0,150.5", "qw..qz", "quaternion norm 0.93 is not 1", 4},
+        BadEdit{"unknown column", "enc3", "enc4", "enc4", "unknown column 12", 2},
+        BadEdit{"misspelt column", "force", "forse", "forse", "unknown column", 2},
+        BadEdit{"duplicate column", ",y,", ",x,", "x", "duplicate column (columns 2 and 3)", 2},
+        BadEdit{"missing column", ",enc2", "", "enc2", "missing column", 2},
+        BadEdit{"empty column name", "qz,", "qz,,", "", "column 9 has no name", 2}),
+    test::case_name);
 
 TEST(SamplesCsv, QuaternionJustInsideToleranceIsNormalised) {
   // GIVEN a quaternion whose norm is 1.0009
