@@ -22,8 +22,9 @@ std::vector<WinchCalibration> read_winches(TomlReader& reader, const toml::table
   std::vector<WinchCalibration> winches;
   for (const toml::table* table : reader.tables(root, "winch", "")) {
     const std::string path = "winch[" + std::to_string(winches.size()) + "]";
-    reader.check_keys(*table, path, {{"anchor", kRequired}, {"anchor_sigma", kRequired}, {"offset", kRequired},
-                                     {"offset_sigma", kRequired}});
+    reader.check_keys(
+        *table, path,
+        {{"anchor", kRequired}, {"anchor_sigma", kRequired}, {"offset", kRequired}, {"offset_sigma", kRequired}});
     WinchCalibration& winch = winches.emplace_back();
     winch.anchor_world = reader.vector3(*table, "anchor", path);
     winch.anchor_sigma = reader.vector3(*table, "anchor_sigma", path, Bound::kNonNegative);
@@ -35,8 +36,12 @@ std::vector<WinchCalibration> read_winches(TomlReader& reader, const toml::table
 
 FitSummary read_fit(TomlReader& reader, const toml::table& root) {
   const toml::table& table = reader.table(root, "fit", "");
-  reader.check_keys(table, "fit", {{"cost_initial", kRequired}, {"cost_final", kRequired}, {"iterations", kRequired},
-                                   {"rms_encoder", kRequired}, {"rms_force", kRequired}});
+  reader.check_keys(table, "fit",
+                    {{"cost_initial", kRequired},
+                     {"cost_final", kRequired},
+                     {"iterations", kRequired},
+                     {"rms_encoder", kRequired},
+                     {"rms_force", kRequired}});
   FitSummary fit;
   fit.cost_initial = reader.number(table, "cost_initial", "fit", Bound::kNonNegative);
   fit.cost_final = reader.number(table, "cost_final", "fit", Bound::kNonNegative);
@@ -55,9 +60,15 @@ Calibration read_calibration(TomlReader& reader, const toml::table& root) {
                 "unsupported format version " + std::to_string(format) + "; this build reads version " +
                     std::to_string(kFormatVersion));
   }
-  reader.check_keys(root, "", {{"format", kRequired}, {"created", kRequired}, {"robot", kRequired},
-                               {"model", kRequired}, {"samples", kRequired}, {"winch", kRequired},
-                               {"fit", kRequired}, {"effects", kOptional}});
+  reader.check_keys(root, "",
+                    {{"format", kRequired},
+                     {"created", kRequired},
+                     {"robot", kRequired},
+                     {"model", kRequired},
+                     {"samples", kRequired},
+                     {"winch", kRequired},
+                     {"fit", kRequired},
+                     {"effects", kOptional}});
   calibration.format = static_cast<int>(format);
   calibration.created = reader.offset_date_time(root, "created", "");
   calibration.robot = reader.string(root, "robot", "");

@@ -28,11 +28,12 @@ std::vector<Winch> read_winches(TomlReader& reader, const toml::table& root) {
   const int count = static_cast<int>(winches.size());
   const int line = TomlReader::line_of(*tables.front());
   if (count < 2) {
-    reader.fail(line, "winch", "found " + std::to_string(count) +
-                                   " [[winch]] table; a cable robot needs at least 2 cables");
+    reader.fail(line, "winch",
+                "found " + std::to_string(count) + " [[winch]] table; a cable robot needs at least 2 cables");
   } else if (count != kCableCount) {
-    reader.fail(line, "winch", "found " + std::to_string(count) + " [[winch]] tables, but the solver handles exactly " +
-                                   std::to_string(kCableCount) + " cables");
+    reader.fail(line, "winch",
+                "found " + std::to_string(count) + " [[winch]] tables, but the solver handles exactly " +
+                    std::to_string(kCableCount) + " cables");
   }
   return winches;
 }
@@ -50,8 +51,13 @@ Robot read_robot(TomlReader& reader, const toml::table& root) {
 
   // Later optional tables (pulley geometry, limits, waypoints) are one more
   // kOptional entry here plus their own reads.
-  reader.check_keys(root, "", {{"name", kRequired}, {"gravity", kOptional}, {"platform", kRequired},
-                               {"cable", kRequired}, {"winch", kRequired}, {"noise", kRequired}});
+  reader.check_keys(root, "",
+                    {{"name", kRequired},
+                     {"gravity", kOptional},
+                     {"platform", kRequired},
+                     {"cable", kRequired},
+                     {"winch", kRequired},
+                     {"noise", kRequired}});
   robot.name = reader.string(root, "name", "");
   robot.gravity_mps2 = reader.optional_number(root, "gravity", "", Bound::kPositive).value_or(Robot{}.gravity_mps2);
 
@@ -72,8 +78,9 @@ Robot read_robot(TomlReader& reader, const toml::table& root) {
   robot.reference_cable = static_cast<int>(reference);
 
   const toml::table& noise = reader.table(root, "noise", "");
-  reader.check_keys(noise, "noise",
-                    {{"encoder", kRequired}, {"force", kRequired}, {"position", kRequired}, {"orientation", kRequired}});
+  reader.check_keys(
+      noise, "noise",
+      {{"encoder", kRequired}, {"force", kRequired}, {"position", kRequired}, {"orientation", kRequired}});
   robot.noise.encoder_m = reader.number(noise, "encoder", "noise", Bound::kPositive);
   robot.noise.force_n = reader.number(noise, "force", "noise", Bound::kPositive);
   robot.noise.position_m = reader.number(noise, "position", "noise", Bound::kPositive);
@@ -87,9 +94,7 @@ Expected<Robot, FormatError> parse_robot_toml(std::string_view text, const std::
   return parse_toml<Robot>(text, source, read_robot);
 }
 
-Expected<Robot, FormatError> read_robot_toml(const std::string& path) {
-  return parse_file(path, parse_robot_toml);
-}
+Expected<Robot, FormatError> read_robot_toml(const std::string& path) { return parse_file(path, parse_robot_toml); }
 
 std::string format_robot_toml(const Robot& robot) {
   std::string out;

@@ -58,12 +58,14 @@ class Header {
       const auto known = std::find(expected.begin(), expected.end(), name);
       if (name.empty()) return fail(line, source, "", "column " + std::to_string(file_column) + " has no name");
       if (known == expected.end()) {
-        return fail(line, source, name, "unknown column " + std::to_string(file_column) + "; expected the columns " +
-                                            joined(expected) + " (in any order)");
+        return fail(line, source, name,
+                    "unknown column " + std::to_string(file_column) + "; expected the columns " + joined(expected) +
+                        " (in any order)");
       }
       if (const auto first = seen.find(name); first != seen.end()) {
-        return fail(line, source, name, "duplicate column (columns " + std::to_string(first->second) + " and " +
-                                            std::to_string(file_column) + ")");
+        return fail(
+            line, source, name,
+            "duplicate column (columns " + std::to_string(first->second) + " and " + std::to_string(file_column) + ")");
       }
       seen.emplace(name, file_column);
       header.names_.push_back(name);
@@ -127,8 +129,8 @@ Expected<Sample, FormatError> parse_row(const TextLine& line, const Header& head
   sample.world_R_platform = Eigen::Quaterniond(values[kQw], values[kQx], values[kQy], values[kQz]);
   const double norm = sample.world_R_platform.norm();
   if (std::abs(norm - 1.0) > kUnitTolerance) {
-    return fail("qw..qz", "quaternion norm " + number_text(norm) + " is not 1 (tolerance " +
-                              number_text(kUnitTolerance) + ")");
+    return fail("qw..qz",
+                "quaternion norm " + number_text(norm) + " is not 1 (tolerance " + number_text(kUnitTolerance) + ")");
   }
   if (std::abs(norm - 1.0) > kAlreadyUnit) sample.world_R_platform.normalize();
   for (int i = 0; i < kCableCount; ++i) sample.encoder_m[i] = values[static_cast<std::size_t>(kFirstEncoder + i)];
@@ -141,13 +143,14 @@ Expected<Sample, FormatError> parse_row(const TextLine& line, const Header& head
 Expected<std::vector<Sample>, FormatError> parse_samples_csv(std::string_view text, const std::string& source,
                                                              int cable_count) {
   if (cable_count != kCableCount) {
-    return Unexpected{FormatError{source, 0, "", "cannot read samples of " + std::to_string(cable_count) +
-                                                     " cables; the solver handles exactly " +
-                                                     std::to_string(kCableCount)}};
+    return Unexpected{FormatError{source, 0, "",
+                                  "cannot read samples of " + std::to_string(cable_count) +
+                                      " cables; the solver handles exactly " + std::to_string(kCableCount)}};
   }
   const std::vector<TextLine> lines = content_lines(text);
   if (lines.empty()) {
-    return Unexpected{FormatError{source, 0, "", "no header line (expected " + joined(column_names(cable_count)) + ")"}};
+    return Unexpected{
+        FormatError{source, 0, "", "no header line (expected " + joined(column_names(cable_count)) + ")"}};
   }
   const auto header = Header::parse(lines.front(), source, cable_count);
   if (!header) return Unexpected{header.error()};
@@ -176,14 +179,15 @@ Expected<std::vector<Sample>, FormatError> read_samples_csv(const std::string& p
 }
 
 std::string format_samples_csv(const std::vector<Sample>& samples) {
-  std::string out = "# samples.csv (FORMATS.md): position [m] world, quaternion platform->world, encoders [m], "
-                    "reference force [N]\n";
+  std::string out =
+      "# samples.csv (FORMATS.md): position [m] world, quaternion platform->world, encoders [m], "
+      "reference force [N]\n";
   out += joined(column_names(kCableCount)) + "\n";
   for (const Sample& s : samples) {
     const Eigen::Quaterniond& q = s.world_R_platform;
     out += std::to_string(s.id);
-    for (const double value : {s.position_world.x(), s.position_world.y(), s.position_world.z(), q.w(), q.x(), q.y(),
-                               q.z()}) {
+    for (const double value :
+         {s.position_world.x(), s.position_world.y(), s.position_world.z(), q.w(), q.x(), q.y(), q.z()}) {
       out += "," + shortest_text(value);
     }
     for (const double reading : s.encoder_m) out += "," + shortest_text(reading);

@@ -163,8 +163,7 @@ std::vector<const toml::table*> TomlReader::tables(const toml::table& parent, st
   const toml::node* node = require(parent, key, path);
   if (node == nullptr) return result;
   if (!node->is_array_of_tables()) {
-    fail(line_of(*node), join_key(path, key),
-         "expected [[" + std::string(key) + "]] tables, got " + type_name(*node));
+    fail(line_of(*node), join_key(path, key), "expected [[" + std::string(key) + "]] tables, got " + type_name(*node));
     return result;
   }
   for (const toml::node& element : *node->as_array()) result.push_back(element.as_table());
@@ -176,7 +175,10 @@ std::optional<double> TomlReader::checked_number(const toml::node& node, const s
     fail(line_of(node), field, "expected a number, got " + type_name(node));
     return std::nullopt;
   }
-  const double value = *node.value<double>();  // toml++ widens integers
+  // Integers are widened here: toml++'s own conversion refuses integers that
+  // a double cannot hold exactly, which is no reason to refuse a mass.
+  const double value =
+      node.is_integer() ? static_cast<double>(node.as_integer()->get()) : node.as_floating_point()->get();
   if (!std::isfinite(value)) {
     fail(line_of(node), field, "expected a finite number, got " + number_text(value));
     return std::nullopt;
@@ -198,8 +200,8 @@ double TomlReader::number(const toml::table& table, std::string_view key, std::s
   return checked_number(*node, join_key(path, key), bound).value_or(0.0);
 }
 
-std::optional<double> TomlReader::optional_number(const toml::table& table, std::string_view key,
-                                                  std::string_view path, Bound bound) {
+std::optional<double> TomlReader::optional_number(const toml::table& table, std::string_view key, std::string_view path,
+                                                  Bound bound) {
   if (failed() || !table.contains(key)) return std::nullopt;
   return checked_number(*table.get(key), join_key(path, key), bound);
 }
@@ -238,7 +240,7 @@ std::vector<std::string> TomlReader::strings(const toml::table& table, std::stri
   const toml::node* node = require(table, key, path);
   if (node == nullptr) return result;
   const toml::array* array = node->as_array();
-  if (array == nullptr || !array->is_homogeneous(toml::node_type::string)) {
+  if (array == nullptr || !(array->empty() || array->is_homogeneous(toml::node_type::string))) {
     fail(line_of(*node), join_key(path, key), "expected an array of strings, got " + type_name(*node));
     return result;
   }
@@ -254,8 +256,8 @@ Eigen::Vector3d TomlReader::vector3(const toml::table& table, std::string_view k
   const std::string field = join_key(path, key);
   const toml::array* array = node->as_array();
   if (array == nullptr || array->size() != 3) {
-    const std::string got = array == nullptr ? type_name(*node)
-                                             : "an array of " + std::to_string(array->size()) + " elements";
+    const std::string got =
+        array == nullptr ? type_name(*node) : "an array of " + std::to_string(array->size()) + " elements";
     fail(line_of(*node), field, "expected an array of 3 numbers [x, y, z], got " + got);
     return result;
   }

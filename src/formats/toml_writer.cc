@@ -1,5 +1,7 @@
 #include "src/formats/toml_writer.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 
@@ -62,8 +64,8 @@ std::string toml_strings(const std::vector<std::string>& values) {
 }
 
 std::string toml_key(std::string_view key) {
-  const bool bare = !key.empty() && key.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
-                                                          "0123456789_-") == std::string_view::npos;
+  const auto bare_char = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-'; };
+  const bool bare = !key.empty() && std::all_of(key.begin(), key.end(), bare_char);
   return bare ? std::string(key) : toml_string(key);
 }
 

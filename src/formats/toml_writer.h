@@ -17,7 +17,7 @@ namespace cdpr::formats {
 // Shortest round-trip text; integral values get ".0" so they read as floats
 // to a human ("34.0"); non-finite values as TOML's nan/inf (which our parsers refuse).
 std::string toml_number(double value);
-std::string toml_vector3(const Eigen::Vector3d& value);  // "[x, y, z]"
+std::string toml_vector3(const Eigen::Vector3d& value);       // "[x, y, z]"
 std::string toml_numbers(const std::vector<double>& values);  // "[a, b, ...]"
 std::string toml_string(std::string_view value);              // quoted, escaped basic string
 std::string toml_strings(const std::vector<std::string>& values);

@@ -28,9 +28,7 @@ Expected<Truth, FormatError> parse_truth_toml(std::string_view text, const std::
   return parse_toml<Truth>(text, source, read_truth);
 }
 
-Expected<Truth, FormatError> read_truth_toml(const std::string& path) {
-  return parse_file(path, parse_truth_toml);
-}
+Expected<Truth, FormatError> read_truth_toml(const std::string& path) { return parse_file(path, parse_truth_toml); }
 
 std::string format_truth_toml(const Truth& truth) {
   std::string out;

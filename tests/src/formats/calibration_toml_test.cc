@@ -103,24 +103,24 @@ TEST_P(CalibrationTomlBadInput, IsRefusedWithKeyAndReason) {
 
 INSTANTIATE_TEST_SUITE_P(
     Cases, CalibrationTomlBadInput,
-    testing::Values(
-        BadEdit{"newer format", "format = 1", "format = 2", "format",
-                 "unsupported format version 2; this build reads version 1"},
-        BadEdit{"format as text", "format = 1", "format = \"1\"", "format", "expected an integer"},
-        BadEdit{"no format", "format = 1", "", "format", "missing required key", 0},
-        BadEdit{"created as string", "created = 2026-11-22T10:15:00Z", "created = \"2026-11-22T10:15:00Z\"",
-                 "created", "expected an offset date-time like 2026-11-22T10:15:00Z, got a string"},
-        BadEdit{"created without zone", "10:15:00Z", "10:15:00", "created", "without offset"},
-        BadEdit{"model not strings", "[\"catenary\"]", "[1]", "model", "expected an array of strings"},
-        BadEdit{"negative samples", "samples = 35", "samples = -1", "samples", "must be a count >= 0"},
-        BadEdit{"negative sigma", "offset_sigma = 0.03", "offset_sigma = -0.03", "winch[0].offset_sigma",
-                 "must be >= 0"},
-        BadEdit{"unknown winch key", "offset = -1.5", "ofset = -1.5", "winch[1].ofset", "did you mean 'offset'?"},
-        BadEdit{"missing fit key", "iterations = 14", "", "fit.iterations", "missing required key", 19},
-        BadEdit{"effect not numeric", "\naxial_stiffness = 1.9e6", "\naxial_stiffness = \"big\"",
-                 "effects.axial_stiffness", "expected a number or an array of numbers"},
-        BadEdit{"effect with nan", "0, 3]", "nan, 3]", "effects.encoder_scale[2]", "finite"},
-        BadEdit{"empty effect", "[1e-4, -2e-4, 0, 3]", "[]", "effects.encoder_scale", "non-empty"}),
+    testing::Values(BadEdit{"newer format", "format = 1", "format = 2", "format",
+                            "unsupported format version 2; this build reads version 1"},
+                    BadEdit{"format as text", "format = 1", "format = \"1\"", "format", "expected an integer"},
+                    BadEdit{"no format", "format = 1", "", "format", "missing required key", 0},
+                    BadEdit{"created as string", "created = 2026-11-22T10:15:00Z", "created = \"2026-11-22T10:15:00Z\"",
+                            "created", "expected an offset date-time like 2026-11-22T10:15:00Z, got a string"},
+                    BadEdit{"created without zone", "10:15:00Z", "10:15:00", "created", "without offset"},
+                    BadEdit{"model not strings", "[\"catenary\"]", "[1]", "model", "expected an array of strings"},
+                    BadEdit{"negative samples", "samples = 35", "samples = -1", "samples", "must be a count >= 0"},
+                    BadEdit{"negative sigma", "offset_sigma = 0.03", "offset_sigma = -0.03", "winch[0].offset_sigma",
+                            "must be >= 0"},
+                    BadEdit{"unknown winch key", "offset = -1.5", "ofset = -1.5", "winch[1].ofset",
+                            "did you mean 'offset'?"},
+                    BadEdit{"missing fit key", "iterations = 14", "", "fit.iterations", "missing required key", 19},
+                    BadEdit{"effect not numeric", "\naxial_stiffness = 1.9e6", "\naxial_stiffness = \"big\"",
+                            "effects.axial_stiffness", "expected a number or an array of numbers"},
+                    BadEdit{"effect with nan", "0, 3]", "nan, 3]", "effects.encoder_scale[2]", "finite"},
+                    BadEdit{"empty effect", "[1e-4, -2e-4, 0, 3]", "[]", "effects.encoder_scale", "non-empty"}),
     test::case_name);
 
 TEST(CalibrationToml, FormatThenParseGivesTheSameCalibration) {
@@ -171,6 +171,18 @@ TEST(CalibrationToml, FormatWithoutEffectsHasNoEffectsTable) {
   const auto again = parse_calibration_toml(text, "written.toml");
   ASSERT_TRUE(again.has_value()) << again.error().message();
   EXPECT_TRUE(again->effects.empty());
+}
+
+TEST(CalibrationToml, EmptyModelListRoundTrips) {
+  // GIVEN a calibration that lists no model terms
+  auto calibration = parse_calibration_toml(kExample, "calibration.toml");
+  ASSERT_TRUE(calibration.has_value());
+  calibration->model.clear();
+  // WHEN it is formatted and parsed again
+  const auto again = parse_calibration_toml(format_calibration_toml(*calibration), "written.toml");
+  // THEN the list is still empty
+  ASSERT_TRUE(again.has_value()) << again.error().message();
+  EXPECT_TRUE(again->model.empty());
 }
 
 TEST(CalibrationTomlDeathTest, FormatRefusesACreatedThatIsNoDateTime) {

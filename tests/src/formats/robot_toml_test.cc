@@ -146,6 +146,16 @@ TEST(RobotToml, IntegersAreAcceptedForNumbers) {
   EXPECT_EQ(robot->platform_mass_kg, 34.0);
 }
 
+TEST(RobotToml, IntegersBeyondDoublePrecisionAreStillNumbers) {
+  // GIVEN an absurd but valid integer that a double cannot hold exactly (2^53 + 1)
+  const std::string text = example_with("mass = 34.0", "mass = 9007199254740993");
+  // WHEN it is parsed
+  const auto robot = parse_robot_toml(text, "robot.toml");
+  // THEN it reads as the nearest double rather than as an error
+  ASSERT_TRUE(robot.has_value()) << robot.error().message();
+  EXPECT_EQ(robot->platform_mass_kg, 9007199254740992.0);
+}
+
 TEST(RobotToml, OptionalKeysHaveTheirDefaultsOrValues) {
   // GIVEN no gravity line and an axial stiffness
   std::string text = example_with("gravity = 9.81 ", "# gravity");
@@ -175,26 +185,22 @@ INSTANTIATE_TEST_SUITE_P(
     Cases, RobotTomlBadValue,
     testing::Values(
         BadEdit{"negative mass", "mass = 34.0", "mass = -34.0", "platform.mass", "must be > 0, got -34"},
-        BadEdit{"zero density", "linear_density = 0.0724", "linear_density = 0", "cable.linear_density",
-                 "must be > 0"},
+        BadEdit{"zero density", "linear_density = 0.0724", "linear_density = 0", "cable.linear_density", "must be > 0"},
         BadEdit{"zero sigma", "force = 5.0", "force = 0.0", "noise.force", "must be > 0"},
         BadEdit{"nan gravity", "gravity = 9.81", "gravity = nan", "gravity", "finite"},
-        BadEdit{"inf anchor", "anchor = [0.0, 0.0, 50.0]", "anchor = [0.0, inf, 50.0]", "winch[0].anchor[1]",
-                 "finite"},
+        BadEdit{"inf anchor", "anchor = [0.0, 0.0, 50.0]", "anchor = [0.0, inf, 50.0]", "winch[0].anchor[1]", "finite"},
         BadEdit{"non-numeric", "mass = 34.0", "mass = \"heavy\"", "platform.mass", "expected a number, got a string"},
         BadEdit{"short array", "center_of_mass = [0.0, 0.0, 0.0]", "center_of_mass = [0.0, 0.0]",
-                 "platform.center_of_mass", "expected an array of 3 numbers [x, y, z], got an array of 2"},
+                "platform.center_of_mass", "expected an array of 3 numbers [x, y, z], got an array of 2"},
         BadEdit{"long array", "attachment = [-0.1, 0.1, 0.0]", "attachment = [-0.1, 0.1, 0.0, 1.0]",
-                 "winch[1].attachment", "got an array of 4"},
-        BadEdit{"scalar for array", "anchor = [200.0, 0.0, 50.0]", "anchor = 200.0", "winch[1].anchor",
-                 "got a number"},
-        BadEdit{"string in array", "anchor = [0.0, 200.0, 50.0]", "anchor = [0.0, \"200\", 50.0]",
-                 "winch[3].anchor[1]", "expected a number"},
+                "winch[1].attachment", "got an array of 4"},
+        BadEdit{"scalar for array", "anchor = [200.0, 0.0, 50.0]", "anchor = 200.0", "winch[1].anchor", "got a number"},
+        BadEdit{"string in array", "anchor = [0.0, 200.0, 50.0]", "anchor = [0.0, \"200\", 50.0]", "winch[3].anchor[1]",
+                "expected a number"},
         BadEdit{"reference past the end", "reference = 0", "reference = 4", "cable.reference",
-                 "cable index 4 does not exist; cables are numbered 0..3"},
+                "cable index 4 does not exist; cables are numbered 0..3"},
         BadEdit{"negative reference", "reference = 0", "reference = -1", "cable.reference", "cable index -1"},
-        BadEdit{"fractional reference", "reference = 0", "reference = 0.5", "cable.reference",
-                 "expected an integer"},
+        BadEdit{"fractional reference", "reference = 0", "reference = 0.5", "cable.reference", "expected an integer"},
         BadEdit{"name not text", "name = \"large\"", "name = 7", "name", "expected a string"}),
     test::case_name);
 
