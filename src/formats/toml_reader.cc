@@ -115,7 +115,8 @@ void TomlReader::check_keys(const toml::table& table, std::string_view path, std
   // Unknown keys first: a misspelt key also makes a required one "missing",
   // and the misspelling is the more useful thing to report.
   for (auto&& [key, node] : table) {
-    const bool known = std::any_of(keys.begin(), keys.end(), [&](const KeySpec& s) { return s.name == key.str(); });
+    const std::string_view name = key.str();  // (clang 14 cannot capture a structured binding)
+    const bool known = std::any_of(keys.begin(), keys.end(), [name](const KeySpec& s) { return s.name == name; });
     if (!known) {
       fail(static_cast<int>(key.source().begin.line), join_key(path, key.str()),
            unknown_key_reason(node, key.str(), keys));
