@@ -74,6 +74,42 @@ inline void expect_jacobians_match(const Factor& factor, const std::vector<TestV
   }
 }
 
+// With a robust loss the factor returns Gauss-Newton-corrected residuals and
+// Jacobians (Ceres' corrector), not derivatives of each other; what must hold
+// is that J^T r is the gradient of the robust cost.
+inline void expect_gradient_matches_cost(const Factor& factor, const std::vector<TestVariable>& vars, double step,
+                                         double tolerance) {
+  const int m = factor.residual_dim();
+  std::vector<const double*> params;
+  for (const auto& v : vars) params.push_back(v.ambient.data());
+  std::vector<std::vector<double>> analytic(vars.size());
+  std::vector<double*> jac_ptrs;
+  for (std::size_t b = 0; b < vars.size(); ++b) {
+    analytic[b].assign(m * vars[b].tangent_dim(), 0.0);
+    jac_ptrs.push_back(analytic[b].data());
+  }
+  std::vector<double> residual(m), scratch(m);
+  double cost = 0.0, cost_plus = 0.0, cost_minus = 0.0;
+  ASSERT_TRUE(factor.evaluate(params.data(), residual.data(), jac_ptrs.data(), &cost));
+  const Eigen::Map<const Eigen::VectorXd> r(residual.data(), m);
+  for (std::size_t b = 0; b < vars.size(); ++b) {
+    const int n = vars[b].tangent_dim();
+    const Eigen::MatrixXd J = Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+        analytic[b].data(), m, n);
+    const Eigen::VectorXd gradient = J.transpose() * r;
+    for (int j = 0; j < n; ++j) {
+      const std::vector<double> vp = perturbed(vars[b], j, step), vm = perturbed(vars[b], j, -step);
+      std::vector<const double*> pp = params, pm = params;
+      pp[b] = vp.data();
+      pm[b] = vm.data();
+      ASSERT_TRUE(factor.evaluate(pp.data(), scratch.data(), nullptr, &cost_plus));
+      ASSERT_TRUE(factor.evaluate(pm.data(), scratch.data(), nullptr, &cost_minus));
+      const double numeric = (cost_plus - cost_minus) / (2.0 * step);
+      EXPECT_NEAR(gradient(j), numeric, tolerance * std::max(1.0, std::abs(numeric))) << "block " << b << " column " << j;
+    }
+  }
+}
+
 inline TestVariable pose_variable(const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
   return {{p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z()}, true};
 }
