@@ -75,7 +75,10 @@ class Header {
     for (const std::string& name : expected) {
       if (!seen.contains(name)) missing += (missing.empty() ? "" : ",") + name;
     }
-    if (!missing.empty()) return fail(line, source, missing, "missing column in the header");
+    if (!missing.empty()) {
+      const bool several = missing.find(',') != std::string::npos;
+      return fail(line, source, missing, several ? "missing columns in the header" : "missing column in the header");
+    }
     return header;
   }
 
