@@ -93,12 +93,12 @@ void fill_fit_rms(const Robot& robot, const std::vector<Sample>& samples, const 
 
 }  // namespace
 
-CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& all_samples,
-                            const CalibrationOptions& options) {
-  CalibrationResult result;
+BuiltProblem build_calibration_problem(const Robot& robot, const std::vector<Sample>& all_samples,
+                                       const CalibrationOptions& options) {
+  BuiltProblem built;
   if (std::string why = check_inputs(robot, all_samples); !why.empty()) {
-    result.message = why;
-    return result;
+    built.message = why;
+    return built;
   }
   Anchors nominal;
   for (int i = 0; i < kCableCount; ++i) nominal[i] = robot.winches[i].anchor_world;
@@ -107,14 +107,14 @@ CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& all_s
 
   // Set-up: a start for every pose; poses the model cannot start from are
   // refused by id, never dropped silently.
-  std::vector<Sample> samples;
+  std::vector<Sample>& samples = built.samples;
   std::vector<Eigen::Vector2d> forces;
   std::vector<std::array<double, kCableCount>> lengths;
   for (const Sample& sample : all_samples) {
     if (catenary) {
       const PoseStart start = start_pose(robot, nominal, sample, options);
       if (!start.usable) {
-        result.rejected_samples.push_back(sample.id);
+        built.rejected_samples.push_back(sample.id);
         continue;
       }
       forces.push_back(start.reference_force);
@@ -125,13 +125,14 @@ CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& all_s
     samples.push_back(sample);
   }
   if (samples.size() < 3) {
-    result.message = "too few usable samples: " + std::to_string(samples.size()) + " of " +
-                     std::to_string(all_samples.size()) + " can be started from the nominal anchors";
-    return result;
+    built.message = "too few usable samples: " + std::to_string(samples.size()) + " of " +
+                    std::to_string(all_samples.size()) + " can be started from the nominal anchors";
+    return built;
   }
   const std::array<double, kCableCount> offsets = mean_offsets(samples, lengths);
 
-  Problem problem;
+  built.problem = std::make_unique<Problem>();
+  Problem& problem = *built.problem;
   for (int i = 0; i < kCableCount; ++i) {
     problem.add_vector(AnchorKey(i), nominal[i]);
     problem.add_vector(OffsetKey(i), Eigen::Matrix<double, 1, 1>(offsets[i]));
@@ -152,6 +153,21 @@ CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& all_s
       }
     }
   }
+  return built;
+}
+
+CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& all_samples,
+                            const CalibrationOptions& options) {
+  CalibrationResult result;
+  BuiltProblem built = build_calibration_problem(robot, all_samples, options);
+  result.rejected_samples = built.rejected_samples;
+  if (!built.problem) {
+    result.message = built.message;
+    return result;
+  }
+  const std::vector<Sample>& samples = built.samples;
+  Problem& problem = *built.problem;
+  const bool catenary = options.cable_model == CableModelKind::kCatenary;
 
   SolverOptions solver_options;
   solver_options.max_iterations = options.max_iterations;

@@ -5,11 +5,13 @@
 // Pure numerics: no I/O, no clock; progress is reported through a callback.
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "solver/calibration.h"
 #include "solver/levenberg_marquardt.h"
+#include "solver/problem.h"
 #include "solver/robot.h"
 #include "solver/sample.h"
 
@@ -34,6 +36,17 @@ struct CalibrationResult {
   SolverSummary solver;
   std::vector<int> rejected_samples;  // sample ids refused before the solve, with reasons in message
 };
+
+// The factor graph of one calibration at its data-driven start, for
+// calibrate() and for benchmarks that must solve exactly the same problem.
+struct BuiltProblem {
+  std::unique_ptr<Problem> problem;   // null when the inputs were refused (see message)
+  std::vector<Sample> samples;        // the samples in the problem, pose k = samples[k]
+  std::vector<int> rejected_samples;  // ids the model could not be started from
+  std::string message;
+};
+BuiltProblem build_calibration_problem(const Robot& robot, const std::vector<Sample>& samples,
+                                       const CalibrationOptions& options);
 
 CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& samples,
                             const CalibrationOptions& options);
