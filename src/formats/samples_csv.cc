@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 
+#include "src/formats/nearest_name.h"
 #include "src/formats/number_text.h"
 #include "src/formats/text_file.h"
 #include "src/formats/text_lines.h"
@@ -44,6 +45,18 @@ std::string number_text(double value) {
   return text;
 }
 
+std::string unknown_column_reason(std::string_view name, int file_column, const std::vector<std::string>& expected) {
+  const std::string reason = "unknown column " + std::to_string(file_column);
+  // An encoder of a cable the robot does not have: say how many it has.
+  if (name.starts_with("enc") && parse_integer(name.substr(3))) {
+    const int cables = static_cast<int>(expected.size()) - kFirstEncoder - 1;  // all but the force column
+    return reason + ": the robot has " + std::to_string(cables) + " cables, enc0..enc" + std::to_string(cables - 1);
+  }
+  const auto nearest = nearest_name(name, std::vector<std::string_view>(expected.begin(), expected.end()));
+  if (nearest) return reason + " (did you mean '" + std::string(*nearest) + "'?)";
+  return reason + "; expected the columns " + joined(expected) + " (in any order)";
+}
+
 // The header: for each file column, which documented column it is.
 class Header {
  public:
@@ -57,11 +70,7 @@ class Header {
       const std::string name(field);
       const auto known = std::find(expected.begin(), expected.end(), name);
       if (name.empty()) return fail(line, source, "", "column " + std::to_string(file_column) + " has no name");
-      if (known == expected.end()) {
-        return fail(line, source, name,
-                    "unknown column " + std::to_string(file_column) + "; expected the columns " + joined(expected) +
-                        " (in any order)");
-      }
+      if (known == expected.end()) return fail(line, source, name, unknown_column_reason(name, file_column, expected));
       if (const auto first = seen.find(name); first != seen.end()) {
         return fail(
             line, source, name,

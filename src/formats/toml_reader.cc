@@ -3,8 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <iterator>
 #include <limits>
+
+#include "src/formats/nearest_name.h"
 
 namespace cdpr::formats {
 namespace {
@@ -35,35 +36,16 @@ std::string number_text(double value) {
   return text;
 }
 
-// Levenshtein distance, for "did you mean" on misspelt keys.
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t substitute = diagonal + (a[i - 1] == b[j - 1] ? 0 : 1);
-      diagonal = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, substitute});
-    }
-  }
-  return row[b.size()];
-}
-
 std::string unknown_key_reason(const toml::node& node, std::string_view key, std::initializer_list<KeySpec> keys) {
-  std::string reason = node.is_table() || node.is_array_of_tables() ? "unknown table" : "unknown key";
-  const KeySpec* nearest = nullptr;
-  std::size_t best = 3;  // suggest only close matches: two edits at most
-  for (const KeySpec& spec : keys) {
-    const std::size_t distance = edit_distance(key, spec.name);
-    if (distance < best) best = distance, nearest = &spec;
-  }
-  if (nearest != nullptr) return reason + " (did you mean '" + std::string(nearest->name) + "'?)";
-  if (keys.size() == 0) return reason + " (this table takes no keys)";
-  reason += " (allowed here: ";
-  for (const KeySpec& spec : keys) reason += std::string(spec.name) + (&spec == std::prev(keys.end()) ? ")" : ", ");
-  return reason;
+  const std::string reason = node.is_table() || node.is_array_of_tables() ? "unknown table" : "unknown key";
+  std::vector<std::string_view> allowed;
+  for (const KeySpec& spec : keys) allowed.push_back(spec.name);
+  if (const auto nearest = nearest_name(key, allowed))
+    return reason + " (did you mean '" + std::string(*nearest) + "'?)";
+  if (allowed.empty()) return reason + " (this table takes no keys)";
+  std::string list;
+  for (const std::string_view name : allowed) list += (list.empty() ? "" : ", ") + std::string(name);
+  return reason + " (allowed here: " + list + ")";
 }
 
 // RFC 3339 text of an offset date-time, the form calibration.toml writes.
