@@ -13,10 +13,18 @@
 
 namespace cdpr::formats {
 
-// `cable_count` is the number of [[winch]] tables; enc0..enc<n-1> must all be present.
+// `cable_count` is the number of [[winch]] tables; enc0..enc<n-1> must all
+// be present (and cable_count must be kCableCount). Blank lines, '#' lines,
+// CRLF endings and blanks around fields are fine. Refused: a missing,
+// unknown or duplicate column; a row with too few or too many values; an
+// empty, non-numeric or non-finite value; a sample id that is no integer or
+// repeats; a quaternion whose norm is off 1 by more than 1e-3 (closer ones
+// are normalised); a file without data rows. Errors carry the file line.
 Expected<std::vector<Sample>, FormatError> parse_samples_csv(std::string_view text, const std::string& source,
                                                              int cable_count);
 Expected<std::vector<Sample>, FormatError> read_samples_csv(const std::string& path, int cable_count);
+// A comment line, the header and one row per sample in shortest round-trip
+// number text: parse_samples_csv reads back identical samples.
 std::string format_samples_csv(const std::vector<Sample>& samples);
 
 }  // namespace cdpr::formats
