@@ -1,6 +1,11 @@
 #pragma once
 // The variables and factors of one calibration problem. Owns both; the
 // solver reads and updates variable values in place.
+//
+// Invariants (checked, abort with a message when broken): a key is added
+// once; every key a factor names exists when the factor is added and appears
+// once in that factor. Adding a variable or factor changes the structure, so
+// it must not happen while a LevenbergMarquardt refers to the problem.
 
 #include <map>
 #include <memory>
@@ -44,9 +49,13 @@ class Problem {
   const std::vector<double>& state() const { return state_; }
   // Applies a tangent step to variable v (pose: retract; others: add).
   void retract(int v, const double* step);
+  // The same on another flat state of this problem's layout (the solver's
+  // candidate copy); allocates nothing.
+  void retract(int v, const double* step, double* state) const;
 
  private:
   void add_variable(Key key, int tangent_dim, int ambient_dim, bool is_pose, const double* value);
+  const Variable& checked(Key key, bool is_pose) const;  // aborts on an unknown key or wrong kind
 
   std::vector<Variable> variables_;
   std::map<Key, int> index_;

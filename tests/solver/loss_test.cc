@@ -1,0 +1,47 @@
+#include "solver/loss.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+namespace cdpr {
+namespace {
+
+TEST(Loss, PlainLeastSquaresWhenWidthNotPositive) {
+  for (double width : {0.0, -1.0}) {
+    // GIVEN no Huber width; THEN cost is r^2/2 and nothing is rescaled
+    const Loss loss{width};
+    for (double r : {-100.0, -0.5, 0.0, 3.0, 1e6}) {
+      EXPECT_DOUBLE_EQ(loss.cost(r), 0.5 * r * r);
+      EXPECT_DOUBLE_EQ(loss.scale(r), 1.0);
+    }
+  }
+}
+
+TEST(Loss, HuberIsQuadraticInsideAndLinearOutside) {
+  // GIVEN width k = 2
+  const Loss loss{2.0};
+  // THEN inside |r| <= k: r^2/2; outside: k|r| - k^2/2, continuous at the width
+  EXPECT_DOUBLE_EQ(loss.cost(1.5), 0.5 * 1.5 * 1.5);
+  EXPECT_DOUBLE_EQ(loss.cost(-2.0), 2.0);
+  EXPECT_DOUBLE_EQ(loss.cost(10.0), 2.0 * 10.0 - 2.0);
+  EXPECT_DOUBLE_EQ(loss.cost(-10.0), 2.0 * 10.0 - 2.0);
+  EXPECT_NEAR(loss.cost(2.0 + 1e-9), loss.cost(2.0), 3e-9);
+}
+
+TEST(Loss, ScaledResidualCarriesTheHuberGradient) {
+  // GIVEN an outlier residual r beyond the width k
+  const Loss loss{1.5};
+  for (double r : {-7.0, 2.0, 40.0}) {
+    // WHEN the solver sees s*r with Jacobian s*J; its gradient (s*r)*(s*J) = s^2 r J
+    const double s = loss.scale(r);
+    // THEN that equals d cost / dr * J (numerically differentiated cost)
+    const double h = 1e-6;
+    const double dcost = (loss.cost(r + h) - loss.cost(r - h)) / (2 * h);
+    EXPECT_NEAR(s * s * r, dcost, 1e-7) << r;
+    EXPECT_LT(s, 1.0);
+  }
+}
+
+}  // namespace
+}  // namespace cdpr
