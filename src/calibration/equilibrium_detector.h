@@ -1,0 +1,106 @@
+#pragma once
+// Decides when the platform has come to rest at a waypoint, and averages the
+// rest window into one sample row (samples.csv, FORMATS.md).
+//
+// Settled means, over the last `window_us` of observations:
+//  - the window is covered (oldest observation at least window_us older than
+//    the newest) by at least `min_samples` observations;
+//  - the load cell's own stable bit is set in every observation;
+//  - the tension's standard deviation is below `max_tension_std_n`;
+//  - the platform's speed and angular rate are below their limits. Rates of
+//    raw consecutive poses are noise divided by the sample interval (5 mm at
+//    50 Hz reads as 0.25 m/s), so the window is cut into kRateBins bins of
+//    equal duration and the rate is the largest change of the bin means
+//    between neighbouring bins over the time between their centres. A platform
+//    still moving or swinging slowly shows up there; white noise is averaged
+//    down by the samples per bin.
+// One observation under a threshold is never enough (STYLE.md).
+//
+// Memory: a fixed-capacity ring allocated at construction; add(), check()
+// and average() never allocate. When more than `capacity` observations fall in
+// the window the oldest are dropped and the window can never be covered:
+// size capacity >= window_us x sample rate (+ margin).
+// Time is passed in (monotonic [us]); time going backwards resets the window.
+// Not thread-safe.
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "hal/clock.h"
+#include "solver/robot.h"
+#include "solver/sample.h"
+
+namespace cdpr::calibration {
+
+struct EquilibriumThresholds {
+  hal::TimeUs window_us = 2'000'000;      // rest window [us]
+  int min_samples = 20;                   // observations in the window, >= kRateBins
+  double max_speed_mps = 0.002;           // platform speed [m/s]
+  double max_angular_rate_radps = 0.002;  // platform angular rate [rad/s]
+  double max_tension_std_n = 10.0;        // tension standard deviation [N]
+};
+
+struct EquilibriumObservation {
+  hal::TimeUs time_us = 0;
+  Eigen::Vector3d position_world = Eigen::Vector3d::Zero();              // [m]
+  Eigen::Quaterniond world_R_platform = Eigen::Quaterniond::Identity();  // unit
+  std::array<double, kCableCount> encoder_m{};                           // [m]
+  double tension_n = 0.0;                                                // [N]
+  bool tension_stable = false;                                           // load cell stable bit
+};
+
+enum class EquilibriumVerdict {
+  kNotEnoughData,   // window not covered yet or too few observations
+  kTensionUnstable, // a load-cell stable bit is clear
+  kTensionSpread,   // tension standard deviation too large
+  kMoving,          // speed too large
+  kRotating,        // angular rate too large
+  kSettled,
+};
+
+const char* to_string(EquilibriumVerdict verdict);
+
+// The verdict and the measured values behind it (for the status line).
+struct EquilibriumCheck {
+  EquilibriumVerdict verdict = EquilibriumVerdict::kNotEnoughData;
+  int samples = 0;
+  hal::TimeUs span_us = 0;           // newest - oldest observation time
+  double speed_mps = 0.0;            // measured as described above
+  double angular_rate_radps = 0.0;
+  double tension_std_n = 0.0;
+  bool settled() const { return verdict == EquilibriumVerdict::kSettled; }
+};
+
+class EquilibriumDetector {
+ public:
+  static constexpr int kRateBins = 4;
+
+  // capacity >= 2: the most observations kept (see above).
+  EquilibriumDetector(const EquilibriumThresholds& thresholds, std::size_t capacity);
+
+  // Forgets every observation (e.g. when a new waypoint starts).
+  void reset();
+  void add(const EquilibriumObservation& observation);
+  EquilibriumCheck check() const;
+  // Mean of the window: position, sign-aligned normalized quaternion mean,
+  // encoders and tension. Precondition: at least one observation.
+  Sample average() const;
+
+  int size() const { return static_cast<int>(count_); }
+  const EquilibriumThresholds& thresholds() const { return thresholds_; }
+
+ private:
+  const EquilibriumObservation& at(std::size_t k) const;  // k = 0: oldest
+  Eigen::Quaterniond mean_orientation() const;
+
+  EquilibriumThresholds thresholds_;
+  std::vector<EquilibriumObservation> ring_;
+  std::size_t first_ = 0;
+  std::size_t count_ = 0;
+};
+
+}  // namespace cdpr::calibration
