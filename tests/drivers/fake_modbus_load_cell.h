@@ -1,0 +1,105 @@
+#pragma once
+// A Modbus TCP load cell for loopback tests: a real libmodbus server on
+// 127.0.0.1 at a free port chosen by the kernel, serving the register map of
+// drivers/modbus/tension_registers.h from a thread. It can be muted (reads
+// requests, never answers) to provoke timeouts. Bounded: stop() shuts the
+// client socket down, so the thread ends even while blocked in a receive.
+
+#include <modbus/modbus.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <thread>
+
+#include "drivers/modbus/tension_registers.h"
+
+namespace cdpr::drivers::modbus::test {
+
+class FakeModbusLoadCell {
+ public:
+  // Serves `register_count` holding registers from address 0 (the cell's map at `base`).
+  explicit FakeModbusLoadCell(int base = 0, int register_count = 8) : base_(base) {
+    context_ = modbus_new_tcp("127.0.0.1", 0);
+    mapping_ = modbus_mapping_new(0, 0, register_count, register_count);
+    listener_ = modbus_tcp_listen(context_, 1);
+    sockaddr_in address{};
+    socklen_t length = sizeof(address);
+    ::getsockname(listener_, reinterpret_cast<sockaddr*>(&address), &length);
+    port_ = ntohs(address.sin_port);
+    thread_ = std::thread([this] { serve(); });
+  }
+  ~FakeModbusLoadCell() { stop(); }
+
+  int port() const { return port_; }
+  void set(float tension_n, bool stable, bool error = false, WordOrder order = WordOrder::kHighWordFirst) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::uint16_t registers[kTensionRegisterCount];
+    encode_tension_registers({tension_n, stable, error}, order, registers);
+    for (int i = 0; i < kTensionRegisterCount; ++i) {
+      mapping_->tab_registers[base_ + i] = registers[i];
+      mapping_->tab_input_registers[base_ + i] = registers[i];
+    }
+  }
+  void mute(bool muted) { muted_ = muted; }
+  // Closes the present client connection (the server then accepts anew).
+  void drop_client() {
+    const int client = client_.load();
+    if (client >= 0) ::shutdown(client, SHUT_RDWR);
+    for (int i = 0; i < 200 && client_.load() == client; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  int requests() const { return requests_; }
+
+  void stop() {
+    if (!thread_.joinable()) return;
+    stopping_ = true;
+    ::shutdown(listener_, SHUT_RDWR);
+    const int client = client_.load();
+    if (client >= 0) ::shutdown(client, SHUT_RDWR);
+    thread_.join();
+    ::close(listener_);
+    modbus_close(context_);
+    modbus_mapping_free(mapping_);
+    modbus_free(context_);
+  }
+
+ private:
+  void serve() {
+    // One client at a time; accept again after it leaves (reconnect tests).
+    while (!stopping_) {
+      int listener = listener_;
+      const int client = modbus_tcp_accept(context_, &listener);
+      if (client < 0) return;
+      client_ = client;
+      std::uint8_t query[MODBUS_TCP_MAX_ADU_LENGTH];
+      for (;;) {
+        const int length = modbus_receive(context_, query);
+        if (length < 0) break;  // client gone or stop()
+        if (length == 0) continue;
+        ++requests_;
+        if (muted_) continue;
+        std::lock_guard<std::mutex> lock(mutex_);
+        modbus_reply(context_, query, length, mapping_);
+      }
+      client_ = -1;
+      ::close(client);
+    }
+  }
+
+  int base_;
+  modbus_t* context_ = nullptr;
+  modbus_mapping_t* mapping_ = nullptr;
+  int listener_ = -1;
+  int port_ = 0;
+  std::atomic<int> client_{-1};
+  std::atomic<bool> muted_{false};
+  std::atomic<bool> stopping_{false};
+  std::atomic<int> requests_{0};
+  std::mutex mutex_;
+  std::thread thread_;
+};
+
+}  // namespace cdpr::drivers::modbus::test
