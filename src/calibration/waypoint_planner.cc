@@ -1,0 +1,177 @@
+#include "src/calibration/waypoint_planner.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <limits>
+#include <random>
+
+namespace cdpr::calibration {
+namespace {
+
+std::string format_number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g", value);
+  return text;
+}
+
+// Why a solved rest pose violates a limit; empty when within all limits.
+std::string limit_violation(const StaticPose& rest, const std::array<double, kCableCount>& payout_m,
+                            const PlannerOptions& options) {
+  for (int i = 0; i < kCableCount; ++i) {
+    const std::string cable = "cable " + std::to_string(i);
+    if (rest.tension_n[i] < options.min_tension_n) {
+      return cable + " tension " + format_number(rest.tension_n[i]) + " N below " +
+             format_number(options.min_tension_n) + " N";
+    }
+    if (rest.tension_n[i] > options.max_tension_n) {
+      return cable + " tension " + format_number(rest.tension_n[i]) + " N above " +
+             format_number(options.max_tension_n) + " N";
+    }
+    if (payout_m[i] < options.min_payout_m || payout_m[i] > options.max_payout_m) {
+      return cable + " payout " + format_number(payout_m[i]) + " m outside [" + format_number(options.min_payout_m) +
+             ", " + format_number(options.max_payout_m) + "] m";
+    }
+  }
+  return {};
+}
+
+struct Box {
+  Eigen::Vector3d low, high;
+};
+
+Box workspace_box(const Robot& robot, const PlannerOptions& options) {
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d high = -low;
+  for (const Winch& winch : robot.winches) {
+    low = low.cwiseMin(winch.anchor_world);
+    high = high.cwiseMax(winch.anchor_world);
+  }
+  low.head<2>().array() += options.margin_m;
+  high.head<2>().array() -= options.margin_m;
+  low.z() = options.z_min_m;
+  high.z() = options.z_max_m;
+  return {low, high};
+}
+
+std::vector<Eigen::Vector3d> jittered_grid(const Box& box, const PlannerOptions& options) {
+  std::mt19937 random(options.seed);
+  std::uniform_real_distribution<double> jitter(-options.jitter_fraction, options.jitter_fraction);
+  const Eigen::Vector3i counts(options.grid_xy, options.grid_xy, options.grid_z);
+  std::vector<Eigen::Vector3d> points;
+  for (int ix = 0; ix < counts.x(); ++ix) {
+    for (int iy = 0; iy < counts.y(); ++iy) {
+      for (int iz = 0; iz < counts.z(); ++iz) {
+        const Eigen::Vector3i index(ix, iy, iz);
+        Eigen::Vector3d point;
+        for (int axis = 0; axis < 3; ++axis) {
+          // Cell centres, so the jitter never leaves the box.
+          const double step = (box.high(axis) - box.low(axis)) / counts(axis);
+          point(axis) = box.low(axis) + step * (index(axis) + 0.5 + jitter(random));
+        }
+        points.push_back(point);
+      }
+    }
+  }
+  return points;
+}
+
+// Farthest-point selection: start nearest `centre`, then repeatedly the
+// candidate farthest from everything chosen so far.
+std::vector<int> farthest_points(const std::vector<Waypoint>& candidates, const Eigen::Vector3d& centre, int count) {
+  std::vector<int> chosen;
+  std::vector<double> distance(candidates.size(), std::numeric_limits<double>::infinity());
+  int next = 0;
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    if ((candidates[k].rest.world_T_platform.position_world - centre).norm() <
+        (candidates[next].rest.world_T_platform.position_world - centre).norm()) {
+      next = static_cast<int>(k);
+    }
+  }
+  while (static_cast<int>(chosen.size()) < count) {
+    chosen.push_back(next);
+    const Eigen::Vector3d& p = candidates[next].rest.world_T_platform.position_world;
+    for (std::size_t k = 0; k < candidates.size(); ++k) {
+      distance[k] = std::min(distance[k], (candidates[k].rest.world_T_platform.position_world - p).norm());
+    }
+    next = static_cast<int>(std::max_element(distance.begin(), distance.end()) - distance.begin());
+  }
+  return chosen;
+}
+
+// Greedy nearest-neighbour tour from `start`: short moves between poses.
+std::vector<Waypoint> travel_order(std::vector<Waypoint> waypoints, const Eigen::Vector3d& start) {
+  std::vector<Waypoint> ordered;
+  Eigen::Vector3d at = start;
+  while (!waypoints.empty()) {
+    auto nearest = std::min_element(waypoints.begin(), waypoints.end(), [&](const Waypoint& a, const Waypoint& b) {
+      return (a.rest.world_T_platform.position_world - at).norm() < (b.rest.world_T_platform.position_world - at).norm();
+    });
+    at = nearest->rest.world_T_platform.position_world;
+    ordered.push_back(std::move(*nearest));
+    waypoints.erase(nearest);
+  }
+  return ordered;
+}
+
+}  // namespace
+
+std::string check_planner_options(const Robot& robot, const PlannerOptions& options) {
+  if (robot.cable_count() != kCableCount) return "the planner needs exactly 4 cables";
+  if (options.waypoint_count < 1) return "waypoint count must be at least 1";
+  if (options.grid_xy < 1 || options.grid_z < 1) return "grid counts must be at least 1";
+  if (!(options.jitter_fraction >= 0.0 && options.jitter_fraction < 0.5)) return "jitter fraction must be in [0, 0.5)";
+  if (!(options.z_min_m <= options.z_max_m)) return "z band is empty (z_min > z_max)";
+  if (!(options.min_tension_n < options.max_tension_n)) return "tension limits are empty (min >= max)";
+  const Box box = workspace_box(robot, options);
+  if (!(box.low.x() < box.high.x() && box.low.y() < box.high.y())) {
+    return "margin " + format_number(options.margin_m) + " m leaves no workspace inside the anchors";
+  }
+  return {};
+}
+
+WaypointPlan plan_waypoints(const Robot& robot, const std::array<double, kCableCount>& payout_offset_m,
+                            const Eigen::Vector3d& start_world, const PlannerOptions& options) {
+  WaypointPlan plan;
+  plan.problem = check_planner_options(robot, options);
+  if (!plan.ok()) return plan;
+  const Box box = workspace_box(robot, options);
+  const auto anchors = nominal_anchors(robot);
+
+  std::vector<Waypoint> feasible;
+  for (const Eigen::Vector3d& position : jittered_grid(box, options)) {
+    auto rest = solve_static_pose(robot, anchors, position);
+    if (!rest) {
+      plan.rejected.push_back({position, rest.error()});
+      continue;
+    }
+    Waypoint waypoint{std::move(*rest), {}};
+    for (int i = 0; i < kCableCount; ++i) waypoint.payout_m[i] = waypoint.rest.arc_length_m[i] + payout_offset_m[i];
+    if (std::string why = limit_violation(waypoint.rest, waypoint.payout_m, options); !why.empty()) {
+      plan.rejected.push_back({position, std::move(why)});
+      continue;
+    }
+    feasible.push_back(std::move(waypoint));
+  }
+  if (static_cast<int>(feasible.size()) < options.waypoint_count) {
+    plan.problem = "only " + std::to_string(feasible.size()) + " of " + std::to_string(options.waypoint_count) +
+                   " waypoints feasible within the limits (" + std::to_string(plan.rejected.size()) + " rejected)";
+    return plan;
+  }
+  std::vector<Waypoint> chosen;
+  for (const int k : farthest_points(feasible, 0.5 * (box.low + box.high), options.waypoint_count)) {
+    chosen.push_back(feasible[k]);
+  }
+  plan.waypoints = travel_order(std::move(chosen), start_world);
+  return plan;
+}
+
+Expected<std::array<double, kCableCount>, std::string> estimate_payout_offsets(
+    const Robot& robot, const Eigen::Vector3d& position_world, const std::array<double, kCableCount>& encoder_m) {
+  const auto rest = solve_static_pose(robot, nominal_anchors(robot), position_world);
+  if (!rest) return Unexpected{"cannot model the start pose: " + rest.error()};
+  std::array<double, kCableCount> offsets{};
+  for (int i = 0; i < kCableCount; ++i) offsets[i] = encoder_m[i] - rest->arc_length_m[i];
+  return offsets;
+}
+
+}  // namespace cdpr::calibration

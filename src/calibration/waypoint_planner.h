@@ -1,0 +1,77 @@
+#pragma once
+// Plans the static poses of one field calibration from the nominal geometry
+// (DESIGN.md step 3): well spread over the workspace so that anchors and
+// offsets are observable, each converted to winch payout targets with the
+// sagging-cable model (static_pose.h) and checked against the limits.
+//
+// Workspace: the anchors' horizontal bounding box inset by `margin_m` on each
+// side, times the world-z band [z_min_m, z_max_m]. Candidates: a jittered grid
+// (grid_xy x grid_xy x grid_z, jitter a fraction of the step, seeded so a plan
+// is reproducible). Every candidate is solved for its rest pose and checked:
+// each cable's tension within [min_tension_n, max_tension_n], each payout
+// target within [min_payout_m, max_payout_m]. From the feasible ones,
+// farthest-point selection picks `waypoint_count` (the first nearest the
+// box centre), then they are ordered greedily by travel from the start
+// position. Rejected candidates are returned with the reason.
+//
+// Payout target of cable i = arc length (Eq. 4) + payout_offset_m[i], the
+// encoder offset: from the previous calibration, or estimated at the start
+// pose with estimate_payout_offsets().
+// Pure logic: no I/O, no clock.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "solver/robot.h"
+#include "src/calibration/static_pose.h"
+
+namespace cdpr::calibration {
+
+struct PlannerOptions {
+  int waypoint_count = 35;
+  double margin_m = 5.0;  // inset from the anchors' xy footprint [m]
+  double z_min_m = 5.0;   // world z band of the platform origin [m]
+  double z_max_m = 30.0;
+  int grid_xy = 8;        // candidates per horizontal axis
+  int grid_z = 4;         // candidates along z
+  double jitter_fraction = 0.3;  // of the grid step, in [0, 0.5)
+  std::uint32_t seed = 1;
+  double min_tension_n = 20.0;   // every cable [N]
+  double max_tension_n = 5000.0;
+  double min_payout_m = -1e9;    // winch travel limits in encoder units [m]
+  double max_payout_m = 1e9;
+};
+
+struct Waypoint {
+  StaticPose rest;                                // predicted rest pose, lengths, tensions
+  std::array<double, kCableCount> payout_m{};     // winch targets [m]
+};
+
+struct RejectedWaypoint {
+  Eigen::Vector3d position_world = Eigen::Vector3d::Zero();
+  std::string reason;  // e.g. "cable 2 tension 4.1 N below 20 N"
+};
+
+struct WaypointPlan {
+  std::vector<Waypoint> waypoints;         // in travel order
+  std::vector<RejectedWaypoint> rejected;  // candidates refused, with reasons
+  std::string problem;                     // non-empty when no usable plan (options, too few feasible)
+  bool ok() const { return problem.empty(); }
+};
+
+// Checks the options (counts, band, margin leaving a box); empty when fine.
+std::string check_planner_options(const Robot& robot, const PlannerOptions& options);
+
+WaypointPlan plan_waypoints(const Robot& robot, const std::array<double, kCableCount>& payout_offset_m,
+                            const Eigen::Vector3d& start_world, const PlannerOptions& options);
+
+// Encoder offsets from one measured rest pose: reading - modelled arc length
+// at that position (its rest orientation, nominal anchors).
+Expected<std::array<double, kCableCount>, std::string> estimate_payout_offsets(
+    const Robot& robot, const Eigen::Vector3d& position_world, const std::array<double, kCableCount>& encoder_m);
+
+}  // namespace cdpr::calibration

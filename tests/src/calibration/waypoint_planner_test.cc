@@ -1,0 +1,150 @@
+#include "src/calibration/waypoint_planner.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "../../solver/test_robots.h"
+#include "solver/cable_prediction.h"
+
+namespace cdpr::calibration {
+namespace {
+
+PlannerOptions large_options() {
+  PlannerOptions options;
+  options.waypoint_count = 35;
+  options.margin_m = 20.0;
+  options.z_min_m = 5.0;
+  options.z_max_m = 35.0;
+  options.min_tension_n = 20.0;
+  options.max_tension_n = 3000.0;
+  return options;
+}
+
+const std::array<double, kCableCount> kOffsets{1.5, -2.0, 0.25, 3.0};
+
+TEST(StaticPose, RestPoseBalancesTheWeightAndReachesEveryAttachment) {
+  // GIVEN the large robot and a position off-centre
+  const Robot robot = test::large_robot();
+  const Eigen::Vector3d position(80.0, 140.0, 20.0);
+  // WHEN its rest pose is solved
+  const auto rest = solve_static_pose(robot, nominal_anchors(robot), position);
+  // THEN the cables carry the platform's weight vertically and every catenary ends at its attachment
+  ASSERT_TRUE(rest) << rest.error();
+  const auto cables = predict_cables(robot, nominal_anchors(robot), rest->world_T_platform, rest->reference_force);
+  ASSERT_TRUE(cables.has_value());
+  double lift_n = 0.0;
+  for (int i = 0; i < kCableCount; ++i) {
+    lift_n += (*cables)[i].f_v_n;
+    const double attachment_z = rest->world_T_platform.transform(robot.winches[i].attachment_platform).z();
+    EXPECT_NEAR((*cables)[i].end_height_m, attachment_z, 1e-6);
+    // AND a sagging cable is longer than its chord
+    const double chord_m =
+        (rest->world_T_platform.transform(robot.winches[i].attachment_platform) - robot.winches[i].anchor_world).norm();
+    EXPECT_GT(rest->arc_length_m[i], chord_m);
+    EXPECT_LT(rest->arc_length_m[i], 1.05 * chord_m);
+  }
+  EXPECT_NEAR(lift_n, robot.platform_mass_kg * robot.gravity_mps2, 1e-6 * lift_n);
+  EXPECT_EQ(rest->world_T_platform.position_world, position);
+}
+
+TEST(WaypointPlanner, PlansWellSpreadWaypointsInsideTheLimits) {
+  // GIVEN the large robot and its workspace options
+  const Robot robot = test::large_robot();
+  const PlannerOptions options = large_options();
+  // WHEN 35 waypoints are planned
+  const WaypointPlan plan = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), options);
+  // THEN there are 35, inside the box and the limits, with payout = arc length + offset
+  ASSERT_TRUE(plan.ok()) << plan.problem;
+  ASSERT_EQ(plan.waypoints.size(), 35u);
+  double min_distance_m = 1e9;
+  for (std::size_t a = 0; a < plan.waypoints.size(); ++a) {
+    const Waypoint& w = plan.waypoints[a];
+    const Eigen::Vector3d p = w.rest.world_T_platform.position_world;
+    EXPECT_GE(p.x(), 20.0);
+    EXPECT_LE(p.x(), 220.0);
+    EXPECT_GE(p.y(), 20.0);
+    EXPECT_LE(p.y(), 200.0);
+    EXPECT_GE(p.z(), options.z_min_m);
+    EXPECT_LE(p.z(), options.z_max_m);
+    for (int i = 0; i < kCableCount; ++i) {
+      EXPECT_GE(w.rest.tension_n[i], options.min_tension_n);
+      EXPECT_LE(w.rest.tension_n[i], options.max_tension_n);
+      EXPECT_DOUBLE_EQ(w.payout_m[i], w.rest.arc_length_m[i] + kOffsets[i]);
+    }
+    for (std::size_t b = a + 1; b < plan.waypoints.size(); ++b) {
+      min_distance_m = std::min(min_distance_m, (p - plan.waypoints[b].rest.world_T_platform.position_world).norm());
+    }
+  }
+  // AND spread: no two closer than half the spacing of a regular lattice of 35 points in the box
+  const double lattice_spacing_m = std::cbrt(200.0 * 180.0 * 30.0 / 35.0);
+  EXPECT_GT(min_distance_m, 0.5 * lattice_spacing_m);
+}
+
+TEST(WaypointPlanner, SameSeedSamePlan) {
+  // GIVEN the same inputs twice
+  const Robot robot = test::large_robot();
+  // WHEN planned twice
+  const WaypointPlan a = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), large_options());
+  const WaypointPlan b = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), large_options());
+  // THEN the plans are identical
+  ASSERT_TRUE(a.ok() && b.ok());
+  for (std::size_t k = 0; k < a.waypoints.size(); ++k) EXPECT_EQ(a.waypoints[k].payout_m, b.waypoints[k].payout_m);
+}
+
+TEST(WaypointPlanner, CandidatesOverTheTensionLimitAreRejectedWithTheReason) {
+  // GIVEN a maximum tension that the low, wide poses exceed
+  const Robot robot = test::large_robot();
+  PlannerOptions options = large_options();
+  options.max_tension_n = 400.0;
+  options.waypoint_count = 5;
+  // WHEN planned
+  const WaypointPlan plan = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), options);
+  // THEN some candidates are rejected naming a cable and the limit, and none chosen violates it
+  ASSERT_FALSE(plan.rejected.empty());
+  EXPECT_NE(plan.rejected.front().reason.find("above 400 N"), std::string::npos) << plan.rejected.front().reason;
+  for (const Waypoint& w : plan.waypoints) {
+    for (double tension_n : w.rest.tension_n) EXPECT_LE(tension_n, 400.0);
+  }
+}
+
+TEST(WaypointPlanner, PayoutLimitsRejectFarCandidatesAndTooFewFeasibleIsAProblem) {
+  // GIVEN a maximum payout that only poses near the middle respect
+  const Robot robot = test::large_robot();
+  PlannerOptions options = large_options();
+  options.max_payout_m = 160.0;
+  options.waypoint_count = 200;
+  // WHEN planned
+  const WaypointPlan plan = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), options);
+  // THEN the payout limit is named per rejected candidate and the plan says how many were feasible
+  ASSERT_FALSE(plan.ok());
+  EXPECT_NE(plan.problem.find("of 200 waypoints feasible"), std::string::npos) << plan.problem;
+  ASSERT_FALSE(plan.rejected.empty());
+  EXPECT_NE(plan.rejected.front().reason.find("payout"), std::string::npos) << plan.rejected.front().reason;
+}
+
+TEST(WaypointPlanner, AMarginLeavingNoWorkspaceIsRefused) {
+  // GIVEN a margin wider than half the footprint
+  PlannerOptions options = large_options();
+  options.margin_m = 150.0;
+  // WHEN the options are checked THEN the margin is named
+  EXPECT_NE(check_planner_options(test::large_robot(), options).find("margin"), std::string::npos);
+}
+
+TEST(WaypointPlanner, OffsetsEstimatedAtARestPoseAreRecovered) {
+  // GIVEN encoder readings of the modelled rest pose plus known offsets
+  const Robot robot = test::large_robot();
+  const Eigen::Vector3d position(150.0, 60.0, 12.0);
+  const auto rest = solve_static_pose(robot, nominal_anchors(robot), position);
+  ASSERT_TRUE(rest);
+  std::array<double, kCableCount> encoder_m{};
+  for (int i = 0; i < kCableCount; ++i) encoder_m[i] = rest->arc_length_m[i] + kOffsets[i];
+  // WHEN the offsets are estimated
+  const auto offsets = estimate_payout_offsets(robot, position, encoder_m);
+  // THEN they are the known ones
+  ASSERT_TRUE(offsets);
+  for (int i = 0; i < kCableCount; ++i) EXPECT_NEAR((*offsets)[i], kOffsets[i], 1e-9);
+}
+
+}  // namespace
+}  // namespace cdpr::calibration
