@@ -1,0 +1,95 @@
+#include "src/calibration/fit_validation.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace cdpr::calibration {
+namespace {
+
+std::string number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", value);
+  return text;
+}
+
+bool all_finite(const WinchCalibration& winch) {
+  return winch.anchor_world.allFinite() && winch.anchor_sigma.allFinite() && std::isfinite(winch.offset_m) &&
+         std::isfinite(winch.offset_sigma_m);
+}
+
+void check_residuals(const FitSummary& fit, const NoiseSigmas& noise, const ValidationLimits& limits,
+                     std::vector<std::string>& reasons) {
+  const double encoder_limit_m = limits.max_rms_encoder_sigmas * noise.encoder_m;
+  if (!(fit.rms_encoder_m <= encoder_limit_m)) {
+    reasons.push_back("encoder residual rms " + number(fit.rms_encoder_m) + " m exceeds " +
+                      number(limits.max_rms_encoder_sigmas) + " sigma (" + number(encoder_limit_m) + " m)");
+  }
+  const double force_limit_n = limits.max_rms_force_sigmas * noise.force_n;
+  if (!(fit.rms_force_n <= force_limit_n)) {
+    reasons.push_back("force residual rms " + number(fit.rms_force_n) + " N exceeds " +
+                      number(limits.max_rms_force_sigmas) + " sigma (" + number(force_limit_n) + " N)");
+  }
+}
+
+void check_winch(int i, const WinchCalibration& winch, const Calibration* previous, const ValidationLimits& limits,
+                 std::vector<std::string>& reasons) {
+  const std::string cable = "cable " + std::to_string(i);
+  if (!all_finite(winch)) {
+    reasons.push_back(cable + ": non-finite anchor, offset or sigma");
+    return;
+  }
+  if (!(winch.anchor_sigma.maxCoeff() <= limits.max_anchor_sigma_m)) {
+    reasons.push_back(cable + ": anchor sigma " + number(winch.anchor_sigma.maxCoeff()) + " m above " +
+                      number(limits.max_anchor_sigma_m) + " m (poorly observed: more or wider waypoints)");
+  }
+  if (!(winch.offset_sigma_m <= limits.max_offset_sigma_m)) {
+    reasons.push_back(cable + ": offset sigma " + number(winch.offset_sigma_m) + " m above " +
+                      number(limits.max_offset_sigma_m) + " m");
+  }
+  if (previous && limits.max_anchor_change_m > 0.0 && i < static_cast<int>(previous->winches.size())) {
+    const double change_m = (winch.anchor_world - previous->winches[i].anchor_world).norm();
+    if (!(change_m <= limits.max_anchor_change_m)) {
+      reasons.push_back(cable + ": anchor moved " + number(change_m) + " m since the previous calibration (limit " +
+                        number(limits.max_anchor_change_m) + " m)");
+    }
+  }
+}
+
+}  // namespace
+
+std::string ValidationResult::summary() const {
+  if (accepted()) return "accepted";
+  std::string text;
+  for (const std::string& reason : reasons) text += (text.empty() ? "" : "; ") + reason;
+  return text;
+}
+
+ValidationResult validate_fit(const CalibrationResult& result, const Robot& robot, const Calibration* previous,
+                              const ValidationLimits& limits) {
+  ValidationResult validation;
+  std::vector<std::string>& reasons = validation.reasons;
+  if (!result.ok) {
+    reasons.push_back("solve failed: " + result.message);
+    return validation;
+  }
+  const bool converged =
+      result.solver.termination == TerminationType::kConverged ||
+      (limits.accept_max_iterations && result.solver.termination == TerminationType::kMaxIterations);
+  if (!converged) reasons.push_back("solver did not converge: " + result.solver.message);
+
+  const Calibration& calibration = result.calibration;
+  if (static_cast<int>(calibration.winches.size()) != robot.cable_count()) {
+    reasons.push_back("calibration has " + std::to_string(calibration.winches.size()) + " cables, robot has " +
+                      std::to_string(robot.cable_count()));
+    return validation;
+  }
+  if (calibration.samples < limits.min_samples) {
+    reasons.push_back("only " + std::to_string(calibration.samples) + " samples (at least " +
+                      std::to_string(limits.min_samples) + " needed)");
+  }
+  check_residuals(calibration.fit, robot.noise, limits, reasons);
+  for (int i = 0; i < robot.cable_count(); ++i) check_winch(i, calibration.winches[i], previous, limits, reasons);
+  return validation;
+}
+
+}  // namespace cdpr::calibration

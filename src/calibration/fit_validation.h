@@ -1,0 +1,50 @@
+#pragma once
+// Accepts or refuses a calibration before it may replace the stored one
+// (DESIGN.md step 5). A refused fit is never committed; every reason is
+// stated so the operator knows what to fix (more waypoints, a loose cable, a
+// moved pulley, a noisy sensor).
+//
+// Checks, each with its own reason when it fails:
+//  - the solver converged (kConverged; kMaxIterations only if allowed);
+//  - one result per cable, every value finite, enough samples;
+//  - residuals consistent with the sensor noise of robot.toml [noise]:
+//    rms_encoder <= max_rms_encoder_sigmas * noise.encoder, same for force;
+//  - uncertainty small: every anchor_sigma axis and offset_sigma below limits;
+//  - plausible change from the previous calibration: each anchor moved at
+//    most max_anchor_change_m (a pulley does not wander metres between
+//    calibrations; a big jump means a bad fit or a mechanical problem that a
+//    person must look at). Offsets are not compared: re-homing an encoder
+//    legitimately changes them.
+// Pure logic.
+
+#include <string>
+#include <vector>
+
+#include "solver/calibrate.h"
+#include "solver/calibration.h"
+#include "solver/robot.h"
+
+namespace cdpr::calibration {
+
+struct ValidationLimits {
+  bool accept_max_iterations = false;  // accept a fit that ran out of iterations
+  int min_samples = 10;
+  double max_rms_encoder_sigmas = 3.0;
+  double max_rms_force_sigmas = 3.0;
+  double max_anchor_sigma_m = 0.05;    // per axis, 1-sigma [m]
+  double max_offset_sigma_m = 0.05;    // 1-sigma [m]
+  double max_anchor_change_m = 0.5;    // |anchor - previous anchor| per cable [m]; <= 0: not checked
+};
+
+struct ValidationResult {
+  std::vector<std::string> reasons;  // empty when accepted
+  bool accepted() const { return reasons.empty(); }
+  // "accepted", or the reasons joined by "; "
+  std::string summary() const;
+};
+
+// `previous` may be null (first calibration).
+ValidationResult validate_fit(const CalibrationResult& result, const Robot& robot, const Calibration* previous,
+                              const ValidationLimits& limits);
+
+}  // namespace cdpr::calibration
