@@ -1,16 +1,13 @@
 #include "src/calibration/fit_validation.h"
 
 #include <cmath>
-#include <cstdio>
+
+#include "src/calibration/message_text.h"
 
 namespace cdpr::calibration {
 namespace {
 
-std::string number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3g", value);
-  return text;
-}
+std::string significant3(double value) { return significant(value, 3); }
 
 bool all_finite(const WinchCalibration& winch) {
   return winch.anchor_world.allFinite() && winch.anchor_sigma.allFinite() && std::isfinite(winch.offset_m) &&
@@ -21,13 +18,13 @@ void check_residuals(const FitSummary& fit, const NoiseSigmas& noise, const Vali
                      std::vector<std::string>& reasons) {
   const double encoder_limit_m = limits.max_rms_encoder_sigmas * noise.encoder_m;
   if (!(fit.rms_encoder_m <= encoder_limit_m)) {
-    reasons.push_back("encoder residual rms " + number(fit.rms_encoder_m) + " m exceeds " +
-                      number(limits.max_rms_encoder_sigmas) + " sigma (" + number(encoder_limit_m) + " m)");
+    reasons.push_back("encoder residual rms " + significant3(fit.rms_encoder_m) + " m exceeds " +
+                      significant3(limits.max_rms_encoder_sigmas) + " sigma (" + significant3(encoder_limit_m) + " m)");
   }
   const double force_limit_n = limits.max_rms_force_sigmas * noise.force_n;
   if (!(fit.rms_force_n <= force_limit_n)) {
-    reasons.push_back("force residual rms " + number(fit.rms_force_n) + " N exceeds " +
-                      number(limits.max_rms_force_sigmas) + " sigma (" + number(force_limit_n) + " N)");
+    reasons.push_back("force residual rms " + significant3(fit.rms_force_n) + " N exceeds " +
+                      significant3(limits.max_rms_force_sigmas) + " sigma (" + significant3(force_limit_n) + " N)");
   }
 }
 
@@ -39,18 +36,18 @@ void check_winch(int i, const WinchCalibration& winch, const Calibration* previo
     return;
   }
   if (!(winch.anchor_sigma.maxCoeff() <= limits.max_anchor_sigma_m)) {
-    reasons.push_back(cable + ": anchor sigma " + number(winch.anchor_sigma.maxCoeff()) + " m above " +
-                      number(limits.max_anchor_sigma_m) + " m (poorly observed: more or wider waypoints)");
+    reasons.push_back(cable + ": anchor sigma " + significant3(winch.anchor_sigma.maxCoeff()) + " m above " +
+                      significant3(limits.max_anchor_sigma_m) + " m (poorly observed: more or wider waypoints)");
   }
   if (!(winch.offset_sigma_m <= limits.max_offset_sigma_m)) {
-    reasons.push_back(cable + ": offset sigma " + number(winch.offset_sigma_m) + " m above " +
-                      number(limits.max_offset_sigma_m) + " m");
+    reasons.push_back(cable + ": offset sigma " + significant3(winch.offset_sigma_m) + " m above " +
+                      significant3(limits.max_offset_sigma_m) + " m");
   }
   if (previous && limits.max_anchor_change_m > 0.0 && i < static_cast<int>(previous->winches.size())) {
     const double change_m = (winch.anchor_world - previous->winches[i].anchor_world).norm();
     if (!(change_m <= limits.max_anchor_change_m)) {
-      reasons.push_back(cable + ": anchor moved " + number(change_m) + " m since the previous calibration (limit " +
-                        number(limits.max_anchor_change_m) + " m)");
+      reasons.push_back(cable + ": anchor moved " + significant3(change_m) + " m since the previous calibration (limit " +
+                        significant3(limits.max_anchor_change_m) + " m)");
     }
   }
 }

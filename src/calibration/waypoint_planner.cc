@@ -1,18 +1,13 @@
 #include "src/calibration/waypoint_planner.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <limits>
 #include <random>
 
+#include "src/calibration/message_text.h"
+
 namespace cdpr::calibration {
 namespace {
-
-std::string format_number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.4g", value);
-  return text;
-}
 
 // Why a solved rest pose violates a limit; empty when within all limits.
 std::string limit_violation(const StaticPose& rest, const std::array<double, kCableCount>& payout_m,
@@ -20,16 +15,16 @@ std::string limit_violation(const StaticPose& rest, const std::array<double, kCa
   for (int i = 0; i < kCableCount; ++i) {
     const std::string cable = "cable " + std::to_string(i);
     if (rest.tension_n[i] < options.min_tension_n) {
-      return cable + " tension " + format_number(rest.tension_n[i]) + " N below " +
-             format_number(options.min_tension_n) + " N";
+      return cable + " tension " + significant(rest.tension_n[i]) + " N below " +
+             significant(options.min_tension_n) + " N";
     }
     if (rest.tension_n[i] > options.max_tension_n) {
-      return cable + " tension " + format_number(rest.tension_n[i]) + " N above " +
-             format_number(options.max_tension_n) + " N";
+      return cable + " tension " + significant(rest.tension_n[i]) + " N above " +
+             significant(options.max_tension_n) + " N";
     }
     if (payout_m[i] < options.min_payout_m || payout_m[i] > options.max_payout_m) {
-      return cable + " payout " + format_number(payout_m[i]) + " m outside [" + format_number(options.min_payout_m) +
-             ", " + format_number(options.max_payout_m) + "] m";
+      return cable + " payout " + significant(payout_m[i]) + " m outside [" + significant(options.min_payout_m) +
+             ", " + significant(options.max_payout_m) + "] m";
     }
   }
   return {};
@@ -124,7 +119,7 @@ std::string check_planner_options(const Robot& robot, const PlannerOptions& opti
   if (!(options.min_tension_n < options.max_tension_n)) return "tension limits are empty (min >= max)";
   const Box box = workspace_box(robot, options);
   if (!(box.low.x() < box.high.x() && box.low.y() < box.high.y())) {
-    return "margin " + format_number(options.margin_m) + " m leaves no workspace inside the anchors";
+    return "margin " + significant(options.margin_m) + " m leaves no workspace inside the anchors";
   }
   return {};
 }
