@@ -16,22 +16,17 @@ bool valid_node_id(int id) { return id >= 1 && id <= kMaxNodeId; }
 }  // namespace
 
 CanConnector make_can_connector(const std::string& endpoint) {
-  if (endpoint.starts_with("socketcan:")) {
-    const std::string interface = endpoint.substr(10);
-    return [interface]() -> hal::Result<std::unique_ptr<CanTransport>> {
-      auto transport = FdCanTransport::open_socketcan(interface);
+  // Both transports are FdCanTransport; only the way to open the fd differs.
+  using Open = hal::Result<std::unique_ptr<FdCanTransport>> (*)(const std::string&);
+  const auto connector = [](Open open, std::string where) -> CanConnector {
+    return [open, where]() -> hal::Result<std::unique_ptr<CanTransport>> {
+      auto transport = open(where);
       if (!transport.ok()) return transport.status();
       return std::unique_ptr<CanTransport>(std::move(transport.value()));
     };
-  }
-  if (endpoint.starts_with("unix:")) {
-    const std::string path = endpoint.substr(5);
-    return [path]() -> hal::Result<std::unique_ptr<CanTransport>> {
-      auto transport = FdCanTransport::connect_unix(path);
-      if (!transport.ok()) return transport.status();
-      return std::unique_ptr<CanTransport>(std::move(transport.value()));
-    };
-  }
+  };
+  if (endpoint.starts_with("socketcan:")) return connector(&FdCanTransport::open_socketcan, endpoint.substr(10));
+  if (endpoint.starts_with("unix:")) return connector(&FdCanTransport::connect_unix, endpoint.substr(5));
   return [endpoint]() -> hal::Result<std::unique_ptr<CanTransport>> {
     return hal::Status(hal::ErrorCode::kInvalidArgument,
                        "CAN endpoint '" + endpoint + "': expected socketcan:<interface> or unix:<path>");

@@ -180,5 +180,17 @@ TEST(CanopenWinchBankConfig, RejectsSharedNodeIdsAndZeroScales) {
   EXPECT_EQ(validate(config), "");
 }
 
+TEST(CanConnector, EndpointsSelectTheTransport) {
+  // GIVEN connectors for each scheme WHEN called here (no AF_CAN, no socket)
+  auto socketcan = make_can_connector("socketcan:cdprtest9")();
+  auto unix_missing = make_can_connector("unix:/tmp/cdpr-no-such-dir/can.sock")();
+  auto bad = make_can_connector("tcp:1.2.3.4:5")();
+  // THEN each fails in its own way
+  ASSERT_FALSE(socketcan.ok());
+  EXPECT_NE(socketcan.status().message().find("socketcan:cdprtest9"), std::string::npos);
+  EXPECT_EQ(unix_missing.status().code(), hal::ErrorCode::kNotConnected);
+  EXPECT_EQ(bad.status().code(), hal::ErrorCode::kInvalidArgument);
+}
+
 }  // namespace
 }  // namespace cdpr::drivers::can
