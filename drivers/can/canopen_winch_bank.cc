@@ -177,7 +177,12 @@ void CanopenWinchBank::dispatch(const CanFrame& frame, hal::TimeUs now_us) {
 
 void CanopenWinchBank::on_heartbeat(Winch& winch, Node& node, NmtState state, hal::TimeUs now_us) {
   node.last_heartbeat_us = now_us;
-  if (state == NmtState::kBootUp && &node == &winch.drive_node) winch.drive.reset();  // rebooted: forget its state
+  if (state == NmtState::kBootUp && &node == &winch.drive_node) {
+    // Rebooted: forget what it said, and do not re-enable it behind the
+    // daemon's back: it stays disabled until enable() is called again.
+    winch.drive.reset();
+    winch.drive.set_goal(Cia402Drive::Goal::kNone);
+  }
   node.nmt_state = state;
   node.start_wanted = state != NmtState::kOperational;
 }

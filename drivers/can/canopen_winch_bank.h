@@ -6,8 +6,9 @@
 //
 // Per node: a heartbeat consumer (alive when heard within
 // heartbeat_timeout_us; a boot-up or pre-operational heartbeat gets an NMT
-// start, rate-limited to one per resend interval; a reboot also resets the
-// drive state machine) and, for drives, a Cia402Drive state machine.
+// start, rate-limited to one per resend interval) and, for drives, a
+// Cia402Drive state machine. A drive that reboots (boot-up heartbeat) is
+// started again but NOT re-enabled: it shows kDisabled until enable().
 //
 // Units: payout [m] = encoder counts x encoder_m_per_count (the encoder's
 // zero is the payout zero; the calibration estimates the offset). Targets go

@@ -161,6 +161,26 @@ TEST_F(CanopenWinchBankTest, EnableResetsAFault) {
   EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kEnabled);
 }
 
+TEST_F(CanopenWinchBankTest, RebootedDriveIsStartedButNotReEnabled) {
+  // GIVEN enabled drives
+  open_and_enable();
+  // WHEN drive 1 reboots (boot-up, pre-operational, switch on disabled)
+  test::FakeCanopenBus::Drive& d = bus_->drive(0);
+  d.booted_us = -1;
+  d.nmt = NmtState::kPreOperational;
+  d.power = cia402::PowerState::kSwitchOnDisabled;
+  run_ms(300);
+  // THEN the bank started it again (NMT) but left it disabled, and motion is not finished
+  EXPECT_EQ(d.nmt, NmtState::kOperational);
+  EXPECT_EQ(d.power, cia402::PowerState::kSwitchOnDisabled);
+  EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kDisabled);
+  EXPECT_FALSE(bank_->motion_finished());
+  // WHEN enable() is called THEN it comes back
+  ASSERT_TRUE(bank_->enable().ok());
+  run_ms(100);
+  EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kEnabled);
+}
+
 TEST_F(CanopenWinchBankTest, LostPeerIsNotConnected) {
   // GIVEN an open bank WHEN the far end closes
   open_and_enable();
