@@ -1,0 +1,47 @@
+#pragma once
+// The states of one field calibration (DESIGN.md "Data flow") and the
+// status the daemon reports on the control socket.
+
+#include <string>
+
+#include "hal/clock.h"
+
+namespace cdpr::calibration {
+
+enum class CalibrationState {
+  kIdle,       // nothing run since start-up
+  kPreflight,  // checking nodes, load cell, pose; enabling the drives
+  kPlan,       // planning waypoints from the geometry
+  kMove,       // winches travelling to waypoint k
+  kSettle,     // waiting for equilibrium at waypoint k
+  kSample,     // averaging the rest window into one sample row
+  kSolve,      // fitting anchors and offsets
+  kValidate,   // accepting or refusing the fit
+  kCommit,     // writing calibration.toml atomically
+  kAbort,      // stopping the winches after a fault or an abort request
+  kDone,       // last run committed a new calibration
+  kFailed,     // last run stopped; status.reason says why; old calibration kept
+};
+
+const char* to_string(CalibrationState state);
+
+// True for the states of a run in progress (preflight .. abort).
+bool is_running(CalibrationState state);
+
+struct CalibrationStatus {
+  CalibrationState state = CalibrationState::kIdle;
+  int waypoint = 0;            // 1-based waypoint being worked on; 0 before planning
+  int waypoint_count = 0;      // N of the plan; 0 before planning
+  int samples = 0;             // waypoints sampled so far
+  int skipped = 0;             // waypoints skipped (settle timeout)
+  double progress = 0.0;       // 0 .. 1 over the whole run
+  std::string reason;          // why the last run failed, or what it committed
+  std::string note;            // latest remark (skipped waypoint, ignored button press, ...)
+  std::string detail;          // what the current state waits for (e.g. "platform moving: 4.1 mm/s")
+  int committed_seq = 0;       // store sequence number committed by the last run; 0 if none
+  hal::TimeUs started_us = -1;        // monotonic start of the last run; -1 never
+  hal::TimeUs state_entered_us = -1;  // when the current state was entered
+  hal::TimeUs finished_us = -1;       // when the last run ended (done or failed)
+};
+
+}  // namespace cdpr::calibration

@@ -1,0 +1,330 @@
+#include "src/calibration/calibration_state_machine.h"
+
+#include <utility>
+
+#include "src/calibration/message_text.h"
+
+namespace cdpr::calibration {
+namespace {
+
+std::string seconds(hal::TimeUs duration_us) { return significant(1e-6 * static_cast<double>(duration_us), 3) + " s"; }
+
+bool in_motion_phase(CalibrationState state) {
+  return state == CalibrationState::kPreflight || state == CalibrationState::kPlan ||
+         state == CalibrationState::kMove || state == CalibrationState::kSettle || state == CalibrationState::kSample;
+}
+
+}  // namespace
+
+SolveFunction make_solver_function(CalibrationOptions options) {
+  return [options = std::move(options)](const Robot& robot, const std::vector<Sample>& samples) {
+    return calibrate(robot, samples, options);
+  };
+}
+
+CalibrationStateMachine::CalibrationStateMachine(const Robot& robot, CalibratorDevices devices,
+                                                 CalibratorOptions options, SolveFunction solve,
+                                                 std::function<std::string()> utc_now_text)
+    : robot_(robot),
+      devices_(devices),
+      options_(std::move(options)),
+      solve_(std::move(solve)),
+      utc_now_text_(std::move(utc_now_text)),
+      monitor_(devices.winches, devices.load_cell, devices.pose, options_.monitor),
+      detector_(options_.equilibrium, options_.equilibrium_capacity) {}
+
+void CalibrationStateMachine::enter(CalibrationState state, hal::TimeUs now_us) {
+  status_.state = state;
+  status_.state_entered_us = now_us;
+  status_.detail.clear();
+}
+
+bool CalibrationStateMachine::request_start(hal::TimeUs now_us) {
+  if (is_running(status_.state)) {
+    status_.note = std::string("start ignored: a calibration is already running (") + to_string(status_.state) +
+                   (status_.waypoint_count > 0
+                        ? ", waypoint " + std::to_string(status_.waypoint) + "/" + std::to_string(status_.waypoint_count)
+                        : std::string()) +
+                   ")";
+    return false;
+  }
+  status_ = CalibrationStatus{};
+  status_.started_us = now_us;
+  status_.note = "started";
+  enable_sent_ = false;
+  previous_.reset();
+  plan_ = WaypointPlan{};
+  waypoint_index_ = 0;
+  samples_.clear();
+  solve_result_.reset();
+  monitor_.reset();
+  detector_.reset();
+  enter(CalibrationState::kPreflight, now_us);
+  update_progress();
+  return true;
+}
+
+bool CalibrationStateMachine::request_abort(hal::TimeUs now_us, const std::string& why) {
+  if (!is_running(status_.state)) {
+    status_.note = "abort ignored: no calibration running";
+    return false;
+  }
+  fail(why, now_us, false);
+  return true;
+}
+
+void CalibrationStateMachine::fail(const std::string& reason, hal::TimeUs now_us, bool fault) {
+  const std::string where = std::string(" (during ") + to_string(status_.state) +
+                            (status_.waypoint > 0 ? ", waypoint " + std::to_string(status_.waypoint) + "/" +
+                                                        std::to_string(status_.waypoint_count)
+                                                  : std::string()) +
+                            ")";
+  enter(CalibrationState::kAbort, now_us);
+  // A fault may mean the robot is not where we think: brake now. An abort
+  // request is an operator's choice: decelerate and hold.
+  hal::Status stopped = fault ? devices_.winches.quick_stop() : devices_.winches.halt();
+  if (!stopped.ok() && !fault) stopped = devices_.winches.quick_stop();
+  status_.reason = reason + where;
+  if (!stopped.ok()) status_.reason += "; stopping the winches failed: " + stopped.to_string();
+  status_.reason += "; previous calibration kept";
+  status_.finished_us = now_us;
+  enter(CalibrationState::kFailed, now_us);
+}
+
+void CalibrationStateMachine::poll_button(hal::TimeUs now_us) {
+  if (!devices_.button) return;
+  const hal::Result<int> presses = devices_.button->take_presses();
+  if (!presses.ok()) {
+    status_.note = "button: " + presses.status().to_string();
+  } else if (presses.value() > 0) {
+    request_start(now_us);
+  }
+}
+
+void CalibrationStateMachine::step(hal::TimeUs now_us) {
+  poll_button(now_us);
+  const CalibrationState state = status_.state;
+  if (in_motion_phase(state)) {
+    if (std::string fault = monitor_.poll(now_us); !fault.empty()) return fail(fault, now_us, true);
+    const bool drives_enabled = state != CalibrationState::kPreflight;
+    if (std::string fault = monitor_.check(now_us, drives_enabled); !fault.empty()) return fail(fault, now_us, true);
+  }
+  switch (state) {
+    case CalibrationState::kPreflight: run_preflight(now_us); break;
+    case CalibrationState::kPlan: run_plan(now_us); break;
+    case CalibrationState::kMove: run_move(now_us); break;
+    case CalibrationState::kSettle: run_settle(now_us); break;
+    case CalibrationState::kSample: run_sample(now_us); break;
+    case CalibrationState::kSolve: run_solve(now_us); break;
+    case CalibrationState::kValidate:
+    case CalibrationState::kCommit: run_validate_and_commit(now_us); break;
+    case CalibrationState::kIdle:
+    case CalibrationState::kAbort:
+    case CalibrationState::kDone:
+    case CalibrationState::kFailed: break;
+  }
+  update_progress();
+}
+
+void CalibrationStateMachine::run_preflight(hal::TimeUs now_us) {
+  if (!enable_sent_) {
+    auto current = devices_.store.load_current();
+    if (current) {
+      previous_ = std::move(*current);
+    } else {
+      status_.note = "current calibration unreadable (" + current.error().message() +
+                     "): calibrating without the change check";
+    }
+    if (const hal::Status s = devices_.winches.enable(); !s.ok()) return fail("enable: " + s.to_string(), now_us, true);
+    enable_sent_ = true;
+    status_.detail = "enabling drives";
+    return;
+  }
+  const Readings& readings = monitor_.readings();
+  for (int i = 0; i < kCableCount; ++i) {
+    if (readings.winches[i].drive != hal::DriveState::kEnabled) {
+      if (now_us - status_.state_entered_us > options_.enable_timeout_us) {
+        return fail("winch " + std::to_string(i) + " drive not enabled after " + seconds(options_.enable_timeout_us) +
+                        " (" + hal::to_string(readings.winches[i].drive) + ")",
+                    now_us, true);
+      }
+      return;
+    }
+  }
+  enter(CalibrationState::kPlan, now_us);
+}
+
+void CalibrationStateMachine::run_plan(hal::TimeUs now_us) {
+  const Readings& readings = monitor_.readings();
+  const Eigen::Vector3d start_world(readings.pose->platform_world.x, readings.pose->platform_world.y,
+                                    readings.pose->platform_world.z);
+  Robot planning_robot = robot_;
+  std::array<double, kCableCount> offsets_m{};
+  const bool use_previous = previous_ && previous_->calibration.winches.size() == robot_.winches.size();
+  if (use_previous) {
+    // The last calibration knows anchors and offsets better than the nominal geometry.
+    for (int i = 0; i < kCableCount; ++i) {
+      planning_robot.winches[i].anchor_world = previous_->calibration.winches[i].anchor_world;
+      offsets_m[i] = previous_->calibration.winches[i].offset_m;
+    }
+  } else {
+    std::array<double, kCableCount> encoder_m{};
+    for (int i = 0; i < kCableCount; ++i) encoder_m[i] = readings.winches[i].payout_m;
+    const auto estimated = estimate_payout_offsets(robot_, start_world, encoder_m);
+    if (!estimated) return fail("plan: " + estimated.error(), now_us, false);
+    offsets_m = *estimated;
+  }
+  plan_ = plan_waypoints(planning_robot, offsets_m, start_world, options_.planner);
+  if (!plan_.ok()) return fail("plan: " + plan_.problem, now_us, false);
+  status_.waypoint_count = static_cast<int>(plan_.waypoints.size());
+  waypoint_index_ = 0;
+  targets_sent_ = false;
+  enter(CalibrationState::kMove, now_us);
+  status_.waypoint = 1;
+}
+
+void CalibrationStateMachine::run_move(hal::TimeUs now_us) {
+  const Waypoint& waypoint = plan_.waypoints[waypoint_index_];
+  if (!targets_sent_) {
+    for (int i = 0; i < kCableCount; ++i) {
+      if (const hal::Status s = devices_.winches.set_target_payout(i, waypoint.payout_m[i]); !s.ok()) {
+        return fail("winch " + std::to_string(i) + " target: " + s.to_string(), now_us, true);
+      }
+    }
+    targets_sent_ = true;
+    status_.detail = "moving to waypoint " + std::to_string(status_.waypoint);
+    return;
+  }
+  if (devices_.winches.motion_finished()) {
+    detector_.reset();
+    enter(CalibrationState::kSettle, now_us);
+    return;
+  }
+  if (now_us - status_.state_entered_us > options_.move_timeout_us) {
+    fail("winches did not reach the waypoint within " + seconds(options_.move_timeout_us), now_us, true);
+  }
+}
+
+void CalibrationStateMachine::run_settle(hal::TimeUs now_us) {
+  const Readings& readings = monitor_.readings();
+  if (readings.pose_is_new && readings.tension) {
+    EquilibriumObservation o;
+    o.time_us = readings.pose->received_us;
+    o.position_world = Eigen::Vector3d(readings.pose->platform_world.x, readings.pose->platform_world.y,
+                                       readings.pose->platform_world.z);
+    const hal::Quaternion& q = readings.pose->world_R_platform;
+    o.world_R_platform = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized();
+    for (int i = 0; i < kCableCount; ++i) o.encoder_m[i] = readings.winches[i].payout_m;
+    o.tension_n = readings.tension->tension_n;
+    o.tension_stable = readings.tension->stable;
+    detector_.add(o);
+  }
+  const EquilibriumCheck check = detector_.check();
+  if (check.settled()) {
+    enter(CalibrationState::kSample, now_us);
+    return;
+  }
+  status_.detail = std::string(to_string(check.verdict)) + ": speed " + significant(1e3 * check.speed_mps, 3) +
+                   " mm/s, rate " + significant(1e3 * check.angular_rate_radps, 3) + " mrad/s, tension std " +
+                   significant(check.tension_std_n, 3) + " N, " + std::to_string(check.samples) + " poses";
+  if (now_us - status_.state_entered_us > options_.settle_timeout_us) {
+    ++status_.skipped;
+    status_.note = "waypoint " + std::to_string(status_.waypoint) + " skipped: no equilibrium within " +
+                   seconds(options_.settle_timeout_us) + " (" + status_.detail + ")";
+    next_waypoint(now_us);
+  }
+}
+
+void CalibrationStateMachine::run_sample(hal::TimeUs now_us) {
+  Sample sample = detector_.average();
+  sample.id = static_cast<int>(samples_.size());
+  samples_.push_back(sample);
+  status_.samples = static_cast<int>(samples_.size());
+  next_waypoint(now_us);
+}
+
+void CalibrationStateMachine::next_waypoint(hal::TimeUs now_us) {
+  ++waypoint_index_;
+  if (waypoint_index_ < static_cast<int>(plan_.waypoints.size())) {
+    targets_sent_ = false;
+    enter(CalibrationState::kMove, now_us);
+    status_.waypoint = waypoint_index_ + 1;
+    return;
+  }
+  if (const hal::Status s = devices_.winches.halt(); !s.ok()) return fail("halt: " + s.to_string(), now_us, true);
+  if (static_cast<int>(samples_.size()) < options_.validation.min_samples) {
+    return fail("only " + std::to_string(samples_.size()) + " of " + std::to_string(plan_.waypoints.size()) +
+                    " waypoints settled (at least " + std::to_string(options_.validation.min_samples) + " needed)",
+                now_us, false);
+  }
+  enter(CalibrationState::kSolve, now_us);
+}
+
+bool CalibrationStateMachine::solve_pending() const {
+  return status_.state == CalibrationState::kSolve && !solve_ && !solve_result_;
+}
+
+void CalibrationStateMachine::deliver_solve_result(CalibrationResult result, hal::TimeUs now_us) {
+  if (!solve_pending()) return;  // aborted meanwhile: the result is dropped
+  solve_result_ = std::move(result);
+  enter(CalibrationState::kValidate, now_us);
+}
+
+void CalibrationStateMachine::run_solve(hal::TimeUs now_us) {
+  if (!solve_) {
+    status_.detail = "waiting for the solver";
+    return;
+  }
+  solve_result_ = solve_(robot_, samples_);
+  enter(CalibrationState::kValidate, now_us);
+}
+
+void CalibrationStateMachine::run_validate_and_commit(hal::TimeUs now_us) {
+  Calibration& calibration = solve_result_->calibration;
+  if (status_.state == CalibrationState::kValidate) {
+    const Calibration* previous = previous_ ? &previous_->calibration : nullptr;
+    const ValidationResult validation = validate_fit(*solve_result_, robot_, previous, options_.validation);
+    if (!validation.accepted()) return fail("fit refused: " + validation.summary(), now_us, false);
+    if (utc_now_text_) calibration.created = utc_now_text_();
+    if (calibration.created.empty()) calibration.created = "1970-01-01T00:00:00Z";
+    calibration.robot = robot_.name;
+    calibration.model = options_.model;
+    calibration.samples = static_cast<int>(samples_.size());
+    enter(CalibrationState::kCommit, now_us);
+    return;
+  }
+  const auto committed = devices_.store.commit(calibration);
+  if (!committed) return fail("store: " + committed.error().message(), now_us, false);
+  status_.committed_seq = *committed;
+  status_.reason = "committed calibration " + std::to_string(*committed) + " from " +
+                   std::to_string(samples_.size()) + " samples (rms encoder " +
+                   significant(1e3 * calibration.fit.rms_encoder_m, 3) + " mm, rms force " +
+                   significant(calibration.fit.rms_force_n, 3) + " N)";
+  status_.finished_us = now_us;
+  enter(CalibrationState::kDone, now_us);
+}
+
+void CalibrationStateMachine::update_progress() {
+  // Waypoints dominate the run's duration; solve and commit take the rest.
+  constexpr double kWaypointsStart = 0.05;
+  constexpr double kWaypointsSpan = 0.85;
+  const int count = std::max(status_.waypoint_count, 1);
+  double phase = 0.0;
+  switch (status_.state) {
+    case CalibrationState::kPreflight: status_.progress = 0.02; return;
+    case CalibrationState::kPlan: status_.progress = 0.04; return;
+    case CalibrationState::kMove: phase = 0.0; break;
+    case CalibrationState::kSettle: phase = 0.5; break;
+    case CalibrationState::kSample: phase = 0.9; break;
+    case CalibrationState::kSolve: status_.progress = 0.92; return;
+    case CalibrationState::kValidate: status_.progress = 0.96; return;
+    case CalibrationState::kCommit: status_.progress = 0.98; return;
+    case CalibrationState::kDone: status_.progress = 1.0; return;
+    case CalibrationState::kIdle:
+    case CalibrationState::kAbort:
+    case CalibrationState::kFailed: return;
+  }
+  status_.progress = kWaypointsStart + kWaypointsSpan * (waypoint_index_ + phase) / count;
+}
+
+}  // namespace cdpr::calibration

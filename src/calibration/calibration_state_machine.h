@@ -1,0 +1,139 @@
+#pragma once
+// The one-button field calibration (DESIGN.md "Data flow"), as an explicit
+// state machine driven by step(now_us): pure logic with time passed in; all
+// I/O goes through the hal interfaces and the store.
+//
+//   idle/done/failed --start--> preflight -> plan -> { move -> settle -> sample }xN
+//     -> solve -> validate -> commit -> done
+//   any fault or abort request while running -> abort -> failed
+//
+// preflight  every winch alive, pose fresh and valid, load cell answering and
+//            the tension inside its limits; enable the drives and wait for
+//            operation enabled (enable_timeout_us). Encoder offsets for the
+//            payout targets: the current calibration's, else estimated at the
+//            start pose (waypoint_planner.h).
+// plan       plan_waypoints() with the current calibration's anchors when one
+//            exists, else the nominal ones; an infeasible plan fails the run.
+// move       payout targets sent; waits for motion_finished() (move_timeout_us
+//            is a fault: a winch is stuck).
+// settle     EquilibriumDetector on every new pose; settle_timeout_us without
+//            equilibrium skips the waypoint (noted), it is not a fault.
+// sample     the window's average becomes one sample row.
+// solve      after the last waypoint the winches are halted (hold). With a
+//            SolveFunction the solve runs inside step(); without, the owner
+//            polls solve_pending(), runs calibrate() on samples() wherever it
+//            likes (a worker thread) and hands the result to
+//            deliver_solve_result().
+// validate   validate_fit() against the current calibration.
+// commit     CalibrationStore::commit(); a store error fails the run and the
+//            store guarantees the old file is intact.
+// abort      quick stop for a fault, halt (decelerate and hold) for an abort
+//            request; the reason goes to status().reason.
+//
+// While running (preflight .. sample) every step polls the hardware once
+// (HardwareMonitor) and any fault aborts. A start request (button or control
+// socket) while running is ignored with a note, never a restart.
+// Not thread-safe: step(), request_*() and deliver_solve_result() from one thread.
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hal/button.h"
+#include "solver/calibrate.h"
+#include "solver/robot.h"
+#include "solver/sample.h"
+#include "src/calibration/calibration_state.h"
+#include "src/calibration/equilibrium_detector.h"
+#include "src/calibration/fit_validation.h"
+#include "src/calibration/hardware_monitor.h"
+#include "src/calibration/waypoint_planner.h"
+#include "src/store/calibration_store.h"
+
+namespace cdpr::calibration {
+
+struct CalibratorOptions {
+  PlannerOptions planner;
+  EquilibriumThresholds equilibrium;
+  std::size_t equilibrium_capacity = 1024;  // >= window x pose rate, with margin
+  ValidationLimits validation;
+  MonitorLimits monitor;
+  hal::TimeUs enable_timeout_us = 5'000'000;
+  hal::TimeUs move_timeout_us = 600'000'000;
+  hal::TimeUs settle_timeout_us = 60'000'000;
+  std::vector<std::string> model{"catenary"};  // written to calibration.toml
+};
+
+using SolveFunction = std::function<CalibrationResult(const Robot&, const std::vector<Sample>&)>;
+
+// A SolveFunction calling solver/calibrate.h with `options`.
+SolveFunction make_solver_function(CalibrationOptions options);
+
+struct CalibratorDevices {
+  hal::WinchBank& winches;  // opened by the owner before the first step
+  hal::LoadCell& load_cell;
+  hal::PoseSource& pose;
+  hal::Button* button = nullptr;  // may be null: starts only by request_start()
+  store::CalibrationStore& store;  // opened by the owner
+};
+
+class CalibrationStateMachine {
+ public:
+  // `utc_now_text` gives calibration.toml's `created` (RFC 3339 UTC); the
+  // state machine never reads a clock itself. `solve` may be empty (see above).
+  CalibrationStateMachine(const Robot& robot, CalibratorDevices devices, CalibratorOptions options,
+                          SolveFunction solve, std::function<std::string()> utc_now_text);
+
+  // Advances the machine; call periodically (e.g. every 20 ms) with monotonic time.
+  void step(hal::TimeUs now_us);
+
+  // Starts a run when not running; otherwise ignored with a note. Returns
+  // whether a run was started. Same effect as a button press.
+  bool request_start(hal::TimeUs now_us);
+  // Aborts a run in progress (winches halted, old calibration kept). Returns
+  // false (and notes it) when nothing is running.
+  bool request_abort(hal::TimeUs now_us, const std::string& why = "abort requested");
+
+  // Asynchronous solve (no SolveFunction given).
+  bool solve_pending() const;
+  const std::vector<Sample>& samples() const { return samples_; }
+  void deliver_solve_result(CalibrationResult result, hal::TimeUs now_us);
+
+  const CalibrationStatus& status() const { return status_; }
+  const WaypointPlan& plan() const { return plan_; }
+
+ private:
+  void enter(CalibrationState state, hal::TimeUs now_us);
+  void fail(const std::string& reason, hal::TimeUs now_us, bool fault);
+  void poll_button(hal::TimeUs now_us);
+  void run_preflight(hal::TimeUs now_us);
+  void run_plan(hal::TimeUs now_us);
+  void run_move(hal::TimeUs now_us);
+  void run_settle(hal::TimeUs now_us);
+  void run_sample(hal::TimeUs now_us);
+  void next_waypoint(hal::TimeUs now_us);
+  void run_solve(hal::TimeUs now_us);
+  void run_validate_and_commit(hal::TimeUs now_us);
+  void update_progress();
+
+  const Robot robot_;
+  CalibratorDevices devices_;
+  CalibratorOptions options_;
+  SolveFunction solve_;
+  std::function<std::string()> utc_now_text_;
+  HardwareMonitor monitor_;
+  EquilibriumDetector detector_;
+
+  CalibrationStatus status_;
+  // Per run:
+  bool enable_sent_ = false;
+  std::optional<store::CurrentCalibration> previous_;
+  WaypointPlan plan_;
+  int waypoint_index_ = 0;  // 0-based
+  bool targets_sent_ = false;
+  std::vector<Sample> samples_;
+  std::optional<CalibrationResult> solve_result_;
+};
+
+}  // namespace cdpr::calibration

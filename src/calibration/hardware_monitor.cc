@@ -1,0 +1,78 @@
+#include "src/calibration/hardware_monitor.h"
+
+#include "src/calibration/message_text.h"
+
+namespace cdpr::calibration {
+namespace {
+
+std::string milliseconds(hal::TimeUs duration_us) { return significant(1e-3 * static_cast<double>(duration_us)) + " ms"; }
+
+}  // namespace
+
+HardwareMonitor::HardwareMonitor(hal::WinchBank& winches, hal::LoadCell& load_cell, hal::PoseSource& pose,
+                                 const MonitorLimits& limits)
+    : winches_(winches), load_cell_(load_cell), pose_(pose), limits_(limits) {}
+
+void HardwareMonitor::reset() {
+  readings_ = Readings{};
+  last_pose_received_us_ = -1;
+  load_cell_errors_in_row_ = 0;
+}
+
+std::string HardwareMonitor::poll(hal::TimeUs now_us) {
+  if (const hal::Status s = winches_.update(now_us); !s.ok()) return "winch bus: " + s.to_string();
+  for (int i = 0; i < kCableCount && i < winches_.winch_count(); ++i) readings_.winches[i] = winches_.status(i);
+
+  if (const hal::Status s = pose_.update(0); !s.ok()) return "pose source: " + s.to_string();
+  readings_.pose = pose_.latest();
+  readings_.pose_is_new = readings_.pose && readings_.pose->received_us != last_pose_received_us_;
+  if (readings_.pose) last_pose_received_us_ = readings_.pose->received_us;
+
+  readings_.tension_is_new = false;
+  const hal::Result<hal::TensionSample> tension = load_cell_.read();
+  if (tension.ok()) {
+    readings_.tension = tension.value();
+    readings_.tension_is_new = true;
+    load_cell_errors_in_row_ = 0;
+  } else if (++load_cell_errors_in_row_ > limits_.max_consecutive_load_cell_errors) {
+    return "load cell: " + tension.status().to_string() + " (" + std::to_string(load_cell_errors_in_row_) +
+           " failed reads in a row)";
+  }
+  return {};
+}
+
+std::string HardwareMonitor::check(hal::TimeUs now_us, bool drives_enabled) const {
+  if (winches_.winch_count() != kCableCount) {
+    return "winch bank has " + std::to_string(winches_.winch_count()) + " winches, robot has 4";
+  }
+  for (int i = 0; i < kCableCount; ++i) {
+    const hal::WinchStatus& w = readings_.winches[i];
+    const std::string winch = "winch " + std::to_string(i);
+    if (!w.alive) {
+      return winch + " node silent (" +
+             (w.heartbeat_age_us < 0 ? std::string("never heard") : "last heard " + milliseconds(w.heartbeat_age_us) +
+                                                                         " ago") +
+             ")";
+    }
+    if (w.drive == hal::DriveState::kFault) return winch + " drive fault";
+    if (drives_enabled && w.drive != hal::DriveState::kEnabled) {
+      return winch + " drive left operation enabled (now " + hal::to_string(w.drive) + ")";
+    }
+  }
+  if (!readings_.pose) return "pose stale: no pose received";
+  const hal::TimeUs pose_age_us = now_us - readings_.pose->received_us;
+  if (pose_age_us > limits_.pose_stale_us) {
+    return "pose stale: last pose " + milliseconds(pose_age_us) + " old (limit " +
+           milliseconds(limits_.pose_stale_us) + ")";
+  }
+  if (!readings_.pose->valid) return "pose source reports tracking lost";
+  if (!readings_.tension) return "load cell: no reading yet";
+  const double tension_n = readings_.tension->tension_n;
+  if (tension_n < limits_.min_tension_n || tension_n > limits_.max_tension_n) {
+    return "tension out of limits: " + significant(tension_n) + " N outside [" + significant(limits_.min_tension_n) +
+           ", " + significant(limits_.max_tension_n) + "] N";
+  }
+  return {};
+}
+
+}  // namespace cdpr::calibration
