@@ -1,7 +1,7 @@
 #include "drivers/can/canopen_winch_bank.h"
 
 #include <algorithm>
-#include <cassert>
+#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -219,7 +219,7 @@ double CanopenWinchBank::payout_m(const Winch& w) const {
 }
 
 hal::WinchStatus CanopenWinchBank::status(int winch) const {
-  assert(winch >= 0 && winch < winch_count());
+  if (winch < 0 || winch >= winch_count()) std::abort();  // caller's broken invariant (hal/winch_bank.h)
   const Winch& w = winches_[static_cast<std::size_t>(winch)];
   hal::WinchStatus s;
   s.payout_m = payout_m(w);

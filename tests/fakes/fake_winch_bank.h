@@ -8,7 +8,7 @@
 // state ("winches stopped") rather than a recorded call sequence.
 
 #include <algorithm>
-#include <cassert>
+#include <cstdlib>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -163,11 +163,11 @@ class FakeWinchBank final : public hal::WinchBank {
   };
 
   Winch& at(int winch) {
-    assert(winch >= 0 && winch < options_.winch_count);
+    if (winch < 0 || winch >= options_.winch_count) std::abort();  // as the real bank: broken invariant
     return winches_[static_cast<std::size_t>(winch)];
   }
   const Winch& at(int winch) const {
-    assert(winch >= 0 && winch < options_.winch_count);
+    if (winch < 0 || winch >= options_.winch_count) std::abort();
     return winches_[static_cast<std::size_t>(winch)];
   }
   hal::Status not_open() const { return hal::Status(hal::ErrorCode::kInvalidState, "fake winch bank: not open"); }
