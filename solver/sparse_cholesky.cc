@@ -201,7 +201,15 @@ void SparseCholesky::solve(const double* b, double* x) {
   if (!s.factorized) die("solve() without a successful factorize()");
   double* rhs = static_cast<double*>(s.rhs->x);
   for (int k = 0; k < s.n; ++k) rhs[k] = b[s.perm[k]];
-  // solution/work_y/work_e are reused when their sizes fit: no allocation.
+  // solution/work_y/work_e are reused when their shapes match what
+  // cholmod_solve2 asks for. The simplicial solve leaves work_y shaped by the
+  // number of right-hand sides (1 x n) although it asks for 4 x n on the next
+  // call, which would free and reallocate it every time; restore the shape
+  // it was allocated with (tests/solver/lm_allocation_test.cc watches this).
+  if (s.work_y != nullptr && s.work_y->nzmax >= 4 * static_cast<std::size_t>(s.n)) {
+    s.work_y->nrow = 4;
+    s.work_y->d = 4;
+  }
   if (!cholmod_solve2(CHOLMOD_A, s.factor, s.rhs, nullptr, &s.solution, nullptr, &s.work_y, &s.work_e, &s.common)) {
     die("cholmod_solve2 failed");
   }
