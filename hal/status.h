@@ -76,7 +76,11 @@ template <typename T>
 class [[nodiscard]] Result {
  public:
   Result(T value) : value_(std::move(value)) {}  // NOLINT: implicit on purpose
-  Result(Status status) : status_(std::move(status)) {}  // NOLINT: must not be ok
+  // From an error. An ok Status here is a caller bug; it becomes an
+  // kInvalidState error rather than an "ok" result without a value.
+  Result(Status status)  // NOLINT: implicit on purpose
+      : status_(status.ok() ? Status(ErrorCode::kInvalidState, "result built from an ok status without a value")
+                            : std::move(status)) {}
 
   bool ok() const { return status_.ok(); }
   const Status& status() const { return status_; }

@@ -65,6 +65,14 @@ TEST(Result, HoldsValueOrStatus) {
   EXPECT_EQ(bad.status().message(), "bad CRC");
 }
 
+TEST(Result, FromAnOkStatusIsAnErrorNotAnEmptyValue) {
+  // GIVEN a result built (by mistake) from an ok status
+  const Result<int> result{Status::Ok()};
+  // THEN it does not claim a value
+  EXPECT_FALSE(result.ok());
+  EXPECT_EQ(result.status().code(), ErrorCode::kInvalidState);
+}
+
 TEST(DriveState, NamesAreDistinct) {
   EXPECT_STRNE(to_string(DriveState::kEnabled), to_string(DriveState::kDisabled));
   EXPECT_STRNE(to_string(DriveState::kFault), to_string(DriveState::kQuickStop));
