@@ -92,6 +92,14 @@ hal::Status CanopenWinchBank::open() {
       node->last_start_sent_us = -1;
     }
   }
+  // Start the nodes now (retried from update() until their heartbeat says
+  // operational).
+  for (Winch& w : winches_) {
+    for (Node* node : {&w.drive_node, &w.encoder_node}) {
+      if (node->id == 0) continue;
+      if (hal::Status s = service_node(*node, now_us_); !s.ok()) return s;
+    }
+  }
   return hal::Status::Ok();
 }
 
