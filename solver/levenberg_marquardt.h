@@ -5,7 +5,15 @@
 // symbolic Cholesky analysis (SparseCholesky) and every scratch buffer;
 // solve() then allocates nothing per iteration (checked by a test that
 // counts heap allocations). The problem's structure must not change while
-// a solver refers to it; values may.
+// a solver refers to it; values may (solve() starts from the current ones).
+//
+// Strategy (Ceres' LevenbergMarquardtStrategy): solve
+// (J^T J + D / radius) dx = -J^T r with D = diag(J^T J) clamped to
+// [1e-6, 1e32]; accept when the actual/predicted cost reduction exceeds 1e-3,
+// every factor evaluates and all values are finite, then
+// radius /= max(1/3, 1 - (2 rho - 1)^3); otherwise (also when the damped
+// matrix is not positive definite) radius /= nu, nu *= 2. The candidate is
+// evaluated on a copy of the state, so a rejected step costs no undo.
 
 #include <functional>
 #include <memory>
@@ -36,7 +44,8 @@ struct SolverOptions {
   double initial_trust_radius = 1e4;
   double max_trust_radius = 1e16;
   double min_trust_radius = 1e-32;
-  // Called once per iteration (accepted or not); may be empty.
+  // Called with iteration 0 (the initial point) and then once per iteration,
+  // accepted or not; may be empty. It runs inside the allocation-free loop.
   std::function<void(const IterationSummary&)> progress;
 };
 
@@ -44,8 +53,8 @@ enum class TerminationType {
   kConverged,           // a tolerance was met
   kMaxIterations,       // ran out of iterations; the result is the best point found
   kNotEvaluable,        // the model cannot be evaluated at the initial point
-  kLinearSolverFailure, // the factorisation failed even with large damping
-  kTrustRegionCollapsed // no step decreased the cost any more
+  kLinearSolverFailure, // the factorisation failed fatally (out of memory, non-finite J^T J)
+  kTrustRegionCollapsed // radius < min_trust_radius: no step decreased the cost any more
 };
 
 struct SolverSummary {
@@ -71,7 +80,9 @@ class LevenbergMarquardt {
 
   // Marginal covariance of the given non-constant variables at the current
   // values (inverse of J^T J without damping), in tangent coordinates, in the
-  // order given. Empty matrix when J^T J is singular.
+  // order given. Empty matrix when J^T J is singular (not positive definite)
+  // or a factor cannot be evaluated. Aborts on an unknown or constant key.
+  // Allocates (it is not part of the loop).
   Eigen::MatrixXd covariance(const std::vector<Key>& keys);
 
  private:
