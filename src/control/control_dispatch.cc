@@ -1,0 +1,45 @@
+#include "src/control/control_dispatch.h"
+
+#include "src/control/control_request.h"
+#include "src/control/control_response.h"
+
+namespace cdpr::control {
+
+std::string respond(std::string_view request_line, calibration::CalibrationStateMachine& machine,
+                    store::CalibrationStore& store, hal::TimeUs now_us) {
+  const auto request = parse_request(request_line);
+  if (!request) return format_error_response(request.error());
+  switch (request->kind) {
+    case RequestKind::kStart:
+      if (!machine.request_start(now_us)) return format_error_response(machine.status().note);
+      return format_ok_response("started");
+    case RequestKind::kAbort:
+      if (!machine.request_abort(now_us, "abort requested on the control socket")) {
+        return format_error_response(machine.status().note);
+      }
+      return format_ok_response("aborted: " + machine.status().reason);
+    case RequestKind::kStatus: return format_status_response(machine.status(), now_us);
+    case RequestKind::kShow: {
+      const auto current = store.load_current();
+      if (!current) return format_error_response(current.error().message());
+      return format_show_response(*current);
+    }
+    case RequestKind::kHistory: {
+      const auto history = store.history();
+      if (!history) return format_error_response(history.error().message());
+      return format_history_response(*history);
+    }
+    case RequestKind::kRollback: {
+      if (calibration::is_running(machine.status().state)) {
+        return format_error_response("rollback refused: a calibration is running (abort it first)");
+      }
+      const auto rolled = store.rollback(request->seq);
+      if (!rolled) return format_error_response("rollback to " + std::to_string(request->seq) + " failed: " +
+                                                rolled.error().message());
+      return format_ok_response("calibration " + std::to_string(*rolled) + " is current");
+    }
+  }
+  return format_error_response("unhandled request");
+}
+
+}  // namespace cdpr::control

@@ -1,0 +1,23 @@
+#pragma once
+// Answers one control-socket request line against the daemon's state
+// machine and store: what the socket server (src/main.cc) calls for every
+// line it reads. Pure logic apart from the store's file access; time is
+// passed in. Never throws; every outcome is one response line
+// (control_response.h).
+//
+// rollback is refused while a calibration runs (the run's validation compares
+// against the current file and its commit would overwrite the rollback).
+
+#include <string>
+#include <string_view>
+
+#include "hal/clock.h"
+#include "src/calibration/calibration_state_machine.h"
+#include "src/store/calibration_store.h"
+
+namespace cdpr::control {
+
+std::string respond(std::string_view request_line, calibration::CalibrationStateMachine& machine,
+                    store::CalibrationStore& store, hal::TimeUs now_us);
+
+}  // namespace cdpr::control

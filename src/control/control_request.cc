@@ -1,0 +1,90 @@
+#include "src/control/control_request.h"
+
+#include <array>
+#include <vector>
+
+namespace cdpr::control {
+namespace {
+
+struct Command {
+  const char* name;
+  RequestKind kind;
+  bool takes_seq;
+};
+
+constexpr std::array<Command, 6> kCommands = {{
+    {"start", RequestKind::kStart, false},
+    {"abort", RequestKind::kAbort, false},
+    {"status", RequestKind::kStatus, false},
+    {"show", RequestKind::kShow, false},
+    {"history", RequestKind::kHistory, false},
+    {"rollback", RequestKind::kRollback, true},
+}};
+
+constexpr const char* kExpected = "expected start, abort, status, show, history or rollback <seq>";
+
+bool is_blank(char c) { return c == ' ' || c == '\t'; }
+
+// The word as it may be echoed back: printable ASCII only, shortened.
+std::string quoted(std::string_view word) {
+  std::string text = "'";
+  for (std::size_t k = 0; k < word.size() && k < 32; ++k) {
+    const unsigned char c = static_cast<unsigned char>(word[k]);
+    text += (c >= 0x20 && c < 0x7f) ? static_cast<char>(c) : '?';
+  }
+  if (word.size() > 32) text += "...";
+  return text + "'";
+}
+
+}  // namespace
+
+const char* to_string(RequestKind kind) {
+  for (const Command& command : kCommands) {
+    if (command.kind == kind) return command.name;
+  }
+  return "unknown";
+}
+
+Expected<Request, std::string> parse_request(std::string_view line) {
+  if (!line.empty() && line.back() == '\n') line.remove_suffix(1);
+  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  if (line.size() > kMaxRequestBytes) {
+    return Unexpected{"request longer than " + std::to_string(kMaxRequestBytes) + " bytes"};
+  }
+  for (const char c : line) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    if (!is_blank(c) && (u < 0x20 || u >= 0x7f)) return Unexpected{std::string("request contains a non-ASCII or control byte")};
+  }
+  std::vector<std::string_view> words;
+  std::size_t k = 0;
+  while (k < line.size()) {
+    while (k < line.size() && is_blank(line[k])) ++k;
+    const std::size_t start = k;
+    while (k < line.size() && !is_blank(line[k])) ++k;
+    if (k > start) words.push_back(line.substr(start, k - start));
+  }
+  if (words.empty()) return Unexpected{std::string("empty request (") + kExpected + ")"};
+
+  for (const Command& command : kCommands) {
+    if (words[0] != command.name) continue;
+    if (!command.takes_seq) {
+      if (words.size() != 1) return Unexpected{std::string(command.name) + " takes no argument"};
+      return Request{command.kind, 0};
+    }
+    if (words.size() != 2) return Unexpected{std::string(command.name) + " takes one argument: <seq>"};
+    const std::string_view digits = words[1];
+    int seq = 0;
+    const bool all_digits = digits.size() <= 9 && !digits.empty() &&
+                            digits.find_first_not_of("0123456789") == std::string_view::npos;
+    if (all_digits) {
+      for (const char c : digits) seq = seq * 10 + (c - '0');
+    }
+    if (!all_digits || seq < 1) {
+      return Unexpected{"sequence number " + quoted(digits) + " is not an integer in 1..999999999"};
+    }
+    return Request{command.kind, seq};
+  }
+  return Unexpected{"unknown command " + quoted(words[0]) + " (" + kExpected + ")"};
+}
+
+}  // namespace cdpr::control

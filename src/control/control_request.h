@@ -1,0 +1,42 @@
+#pragma once
+// The control socket's request language (the daemon's Unix stream socket,
+// e.g. /run/cdpr-calib/control; client: calibctl).
+//
+// One request per line, ASCII, terminated by "\n" (a "\r" before it is
+// accepted), at most kMaxRequestBytes bytes without the terminator; words
+// separated by single or repeated spaces or tabs:
+//
+//   start            start a calibration (as the button)
+//   abort            abort the calibration in progress
+//   status           state, waypoint k/N, progress, reasons
+//   show             the current calibration
+//   history          the stored versions
+//   rollback <seq>   make stored version <seq> current again (seq: 1..999999999)
+//
+// Every request gets exactly one response line (control_response.h). The
+// parser accepts any byte sequence without crashing and refuses everything
+// not listed above with a reason (fuzzed in tests/src/control).
+
+#include <string>
+#include <string_view>
+
+#include "src/formats/expected.h"
+
+namespace cdpr::control {
+
+inline constexpr std::size_t kMaxRequestBytes = 256;
+
+enum class RequestKind { kStart, kAbort, kStatus, kShow, kHistory, kRollback };
+
+const char* to_string(RequestKind kind);
+
+struct Request {
+  RequestKind kind = RequestKind::kStatus;
+  int seq = 0;  // kRollback only
+};
+
+// Parses one line (with or without its "\n"). The error is a short reason
+// for the client, e.g. "unknown command 'strat' (expected start, abort, ...)".
+Expected<Request, std::string> parse_request(std::string_view line);
+
+}  // namespace cdpr::control

@@ -1,0 +1,37 @@
+#pragma once
+// Responses of the control socket: exactly one line per request, a JSON
+// object terminated by "\n", never containing another newline.
+//
+//   error (any request)  {"ok":false,"error":"unknown command 'strat' (...)"}
+//   start/abort/rollback {"ok":true,"message":"started"}
+//   status   {"ok":true,"state":"settle","running":true,"waypoint":3,"waypoints":35,
+//             "samples":2,"skipped":0,"progress":0.12,"elapsed_s":41.2,
+//             "reason":"","note":"","detail":"platform moving: ...","committed_seq":0}
+//            elapsed_s: since the last run started (to its end when finished); null if never run
+//   show     {"ok":true,"present":true,"seq":4,"created":"2026-11-22T10:15:00Z","robot":"large",
+//             "model":["catenary"],"samples":35,
+//             "winches":[{"anchor":[x,y,z],"anchor_sigma":[..],"offset":3.2,"offset_sigma":0.03},...],
+//             "fit":{"cost_initial":..,"cost_final":..,"iterations":14,"rms_encoder":..,"rms_force":..}}
+//            {"ok":true,"present":false} when nothing was ever committed
+//   history  {"ok":true,"history":[{"seq":4,"current":true,"valid":true,"created":"..","robot":"..",
+//             "samples":35,"problem":""},...]}   newest first
+// Units as in calibration.toml (m, N); progress in [0, 1].
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "hal/clock.h"
+#include "src/calibration/calibration_state.h"
+#include "src/store/calibration_store.h"
+
+namespace cdpr::control {
+
+std::string format_error_response(std::string_view reason);
+std::string format_ok_response(std::string_view message);
+std::string format_status_response(const calibration::CalibrationStatus& status, hal::TimeUs now_us);
+std::string format_show_response(const std::optional<store::CurrentCalibration>& current);
+std::string format_history_response(const std::vector<store::HistoryEntry>& history);
+
+}  // namespace cdpr::control

@@ -1,0 +1,77 @@
+#include "src/control/control_dispatch.h"
+
+#include <gtest/gtest.h>
+
+#include "../calibration/calibration_rig.h"
+
+namespace cdpr::control {
+namespace {
+
+using calibration::test::CalibrationRig;
+
+bool contains(const std::string& text, const std::string& words) { return text.find(words) != std::string::npos; }
+
+std::string ask(CalibrationRig& rig, const std::string& line) {
+  const std::string response = respond(line, *rig.machine, rig.store, rig.clock.now_us());
+  EXPECT_EQ(response.back(), '\n');
+  EXPECT_EQ(response.find('\n'), response.size() - 1) << "one line per response";
+  return response;
+}
+
+TEST(ControlDispatch, StatusOfAnIdleDaemon) {
+  // GIVEN a daemon that never ran WHEN asked for status THEN idle, nothing elapsed
+  CalibrationRig rig;
+  EXPECT_EQ(ask(rig, "status"),
+            "{\"ok\":true,\"state\":\"idle\",\"running\":false,\"waypoint\":0,\"waypoints\":0,\"samples\":0,"
+            "\"skipped\":0,\"progress\":0,\"elapsed_s\":null,\"reason\":\"\",\"note\":\"\",\"detail\":\"\","
+            "\"committed_seq\":0}\n");
+}
+
+TEST(ControlDispatch, StartTwiceAbortAndRollbackWhileRunning) {
+  // GIVEN a daemon started over the socket
+  CalibrationRig rig;
+  EXPECT_EQ(ask(rig, "start"), "{\"ok\":true,\"message\":\"started\"}\n");
+  ASSERT_TRUE(rig.run_to(calibration::CalibrationState::kMove, 2));
+  // WHEN started again, rolled back, then aborted
+  const std::string again = ask(rig, "start");
+  const std::string rollback = ask(rig, "rollback 1");
+  const std::string status = ask(rig, "status");
+  const std::string abort = ask(rig, "abort");
+  // THEN the second start and the rollback are refused, status shows the waypoint, abort stops the run
+  EXPECT_TRUE(contains(again, "\"ok\":false") && contains(again, "already running")) << again;
+  EXPECT_TRUE(contains(rollback, "rollback refused: a calibration is running")) << rollback;
+  EXPECT_TRUE(contains(status, "\"state\":\"move\",\"running\":true,\"waypoint\":2,\"waypoints\":6")) << status;
+  EXPECT_TRUE(contains(abort, "\"ok\":true") && contains(abort, "abort requested on the control socket")) << abort;
+  EXPECT_TRUE(rig.winches.all_stopped());
+  EXPECT_TRUE(rig.previous_calibration_intact());
+  EXPECT_TRUE(contains(ask(rig, "abort"), "abort ignored: no calibration running"));
+}
+
+TEST(ControlDispatch, ShowHistoryAndRollbackAfterACalibration) {
+  // GIVEN a completed calibration on top of the previous one
+  CalibrationRig rig;
+  ask(rig, "start");
+  ASSERT_TRUE(rig.run_to_end());
+  // WHEN show, history and rollback 1 are asked
+  const std::string show = ask(rig, "show");
+  const std::string history = ask(rig, "history");
+  const std::string rollback = ask(rig, "rollback 1");
+  // THEN show gives the new calibration, history both versions, and the rollback restores the old bytes
+  EXPECT_TRUE(contains(show, "\"present\":true,\"seq\":2,\"created\":\"2026-11-23T08:00:00Z\"")) << show;
+  EXPECT_TRUE(contains(show, "\"winches\":[{\"anchor\":[0.03,0,50]")) << show;
+  EXPECT_TRUE(contains(history, "{\"seq\":2,\"current\":true") && contains(history, "{\"seq\":1,\"current\":false"))
+      << history;
+  EXPECT_EQ(rollback, "{\"ok\":true,\"message\":\"calibration 1 is current\"}\n");
+  EXPECT_TRUE(rig.previous_calibration_intact());
+  EXPECT_TRUE(contains(ask(rig, "rollback 9"), "rollback to 9 failed: open"));
+}
+
+TEST(ControlDispatch, GarbageGetsAnErrorLine) {
+  // GIVEN bytes that are no request WHEN sent THEN a JSON error line comes back
+  CalibrationRig rig;
+  const std::string response = ask(rig, "\xff\xfe{\"json\":1}");
+  EXPECT_TRUE(contains(response, "{\"ok\":false,\"error\":\"request contains a non-ASCII")) << response;
+}
+
+}  // namespace
+}  // namespace cdpr::control
