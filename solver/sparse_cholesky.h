@@ -3,8 +3,14 @@
 // fixed pattern (compressed sparse column, upper triangle). Contract (after
 // Ceres' sparse_cholesky.h): the symbolic analysis is done once in the
 // constructor; factorize() refactorises numerically and solve() back-solves,
-// both reusing all memory sized at construction. cholmod.h appears only in
-// the implementation.
+// both reusing all memory sized at construction: neither allocates (the
+// constructor runs one factorisation and solve so CHOLMOD's lazily allocated
+// parts exist). cholmod.h appears only in the implementation.
+//
+// Implementation: AMD order computed once, the matrix stored permuted, and a
+// simplicial LL' factor (an indefinite matrix fails instead of producing a
+// negative pivot). Every column must have its diagonal entry in the pattern.
+// solve() before a successful factorize() aborts.
 
 #include <memory>
 #include <string>
