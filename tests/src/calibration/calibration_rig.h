@@ -130,18 +130,36 @@ class CalibrationRig {
   // waypoint's planned pose otherwise (or at the start before a plan).
   hal::PoseSample platform(hal::TimeUs now_us) {
     Eigen::Vector3d position(120.0, 110.0, 10.0);
-    const int k = active->status().waypoint;
-    if (k > 0 && k <= static_cast<int>(active->plan().waypoints.size())) {
-      position = active->plan().waypoints[k - 1].rest.world_T_platform.position_world;
+    Eigen::Quaterniond world_R_platform = Eigen::Quaterniond::Identity();
+    if (const Waypoint* waypoint = current_waypoint()) {
+      position = waypoint->rest.world_T_platform.position_world;
+      world_R_platform = waypoint->rest.world_T_platform.world_R_platform;
     }
     bool moving = false;
     for (int i = 0; i < winches.winch_count(); ++i) moving = moving || winches.moving(i);
     if (moving || swinging) position.x() += 0.2 * std::sin(1e-6 * static_cast<double>(now_us));
     hal::PoseSample sample;
     sample.platform_world = {position.x(), position.y(), position.z()};
+    sample.world_R_platform = {world_R_platform.w(), world_R_platform.x(), world_R_platform.y(),
+                               world_R_platform.z()};
     sample.valid = true;
     sample.source_time_us = now_us;
     return sample;
+  }
+
+  const Waypoint* current_waypoint() const {
+    const int k = active->status().waypoint;
+    if (k < 1 || k > static_cast<int>(active->plan().waypoints.size())) return nullptr;
+    return &active->plan().waypoints[k - 1];
+  }
+
+  // The load cell reads the modelled tension of the reference cable at the
+  // current waypoint, so samples are consistent with the catenary model.
+  void use_model_tension() {
+    load_cell.set_source([this](hal::TimeUs) {
+      const Waypoint* waypoint = current_waypoint();
+      return std::make_pair(waypoint ? waypoint->rest.tension_n[robot.reference_cable] : 300.0, true);
+    });
   }
 
   fakes::ManualClock clock;
