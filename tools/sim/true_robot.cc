@@ -1,0 +1,36 @@
+#include "sim/true_robot.h"
+
+#include <cmath>
+
+namespace cdpr::sim {
+namespace {
+
+std::vector<double> values_of(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+}  // namespace
+
+EffectValues effect_values(const HiddenEffects& e) {
+  EffectValues values;
+  if (std::isfinite(e.axial_stiffness_n)) values["axial_stiffness"] = {e.axial_stiffness_n};
+  bool any_scale = false;
+  for (double s : e.encoder_scale) any_scale = any_scale || s != 0.0;
+  if (any_scale) values["encoder_scale"] = {e.encoder_scale.begin(), e.encoder_scale.end()};
+  if (e.force_bias_n != 0.0) values["force_bias"] = {e.force_bias_n};
+  if (e.force_gain != 0.0) values["force_gain"] = {e.force_gain};
+  if (!e.com_offset_platform.isZero(0.0)) values["com_offset"] = values_of(e.com_offset_platform);
+  if (e.density_error != 0.0) values["density_error"] = {e.density_error};
+  if (e.pulley_radius_m != 0.0) values["pulley_radius"] = {e.pulley_radius_m};
+  if (!e.wind_force_world_n.isZero(0.0)) values["wind_force"] = values_of(e.wind_force_world_n);
+  return values;
+}
+
+Truth truth_of(const TrueRobot& robot) {
+  Truth truth;
+  for (int i = 0; i < robot.robot.cable_count(); ++i) {
+    truth.winches.push_back({robot.robot.winches[i].anchor_world, robot.encoder_offset_m[i]});
+  }
+  truth.effects = effect_values(robot.effects);
+  return truth;
+}
+
+}  // namespace cdpr::sim
