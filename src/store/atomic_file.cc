@@ -73,7 +73,8 @@ StoreResult<Done> write_file_atomically(const std::string& dir, const std::strin
     ::unlink(temp_path.c_str());  // leave no stray temp; the old file is untouched
     return Unexpected{error};
   }
-  if (crash_requested(hook, first_step + 3)) return Unexpected{simulated_crash(final_path, first_step + 3)};
+  const int renamed_step = first_step + kAtomicRenameStepOffset;
+  if (crash_requested(hook, renamed_step)) return Unexpected{simulated_crash(final_path, renamed_step)};
 
   const auto synced = fsync_directory(dir);
   if (!synced) return synced;

@@ -26,6 +26,8 @@ namespace cdpr::store {
 using CrashHook = std::function<bool(int step)>;
 
 inline constexpr int kAtomicWriteSteps = 5;
+// Offset (from first_step) of the step after which the new content is in place.
+inline constexpr int kAtomicRenameStepOffset = 3;
 
 // Replaces dir/name by `content` as above. A simulated crash returns a
 // StoreError with operation "crash".

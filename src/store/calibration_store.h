@@ -61,6 +61,9 @@ class CalibrationStore {
   static constexpr const char* kHistoryDir = "history";
   static constexpr int kCommitSteps = 2 * kAtomicWriteSteps + 2;
   static constexpr int kRollbackSteps = kAtomicWriteSteps;
+  // From the end of these steps on, calibration.toml holds the new content.
+  static constexpr int kCommitReplacedStep = 1 + kAtomicWriteSteps + kAtomicRenameStepOffset;
+  static constexpr int kRollbackReplacedStep = 1 + kAtomicRenameStepOffset;
 
   explicit CalibrationStore(StoreOptions options);
 

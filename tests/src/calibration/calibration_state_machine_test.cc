@@ -194,7 +194,7 @@ TEST(CalibrationStateMachine, AbortMidRunHaltsAndKeepsTheOldCalibration) {
 }
 
 TEST(CalibrationStateMachine, FailureDuringCommitKeepsTheOldCalibrationByteForByte) {
-  for (int crash_step = 1; crash_step <= store::kAtomicWriteSteps + 3; ++crash_step) {
+  for (int crash_step = 1; crash_step < store::CalibrationStore::kCommitReplacedStep; ++crash_step) {
     SCOPED_TRACE("store stops after step " + std::to_string(crash_step));
     // GIVEN a run whose commit is interrupted before the rename of calibration.toml
     CalibrationRig rig;

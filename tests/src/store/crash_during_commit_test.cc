@@ -15,9 +15,6 @@ using test::calibration_version;
 using test::file_bytes;
 using test::TempStateDir;
 
-// The step after which the current file holds the new content.
-constexpr int kCommitRenameStep = 1 + kAtomicWriteSteps + 3;
-
 TEST(CrashDuringCommit, EveryStepLeavesTheOldOrTheNewFileComplete) {
   const std::string old_text = formats::format_calibration_toml(calibration_version(1));
   const std::string new_text = formats::format_calibration_toml(calibration_version(2));
@@ -38,7 +35,7 @@ TEST(CrashDuringCommit, EveryStepLeavesTheOldOrTheNewFileComplete) {
     ASSERT_TRUE(reopened.open());
     const auto current = reopened.load_current();
     ASSERT_TRUE(current && current->has_value()) << (current ? "" : current.error().message());
-    EXPECT_EQ((*current)->text, crash_step < kCommitRenameStep ? old_text : new_text);
+    EXPECT_EQ((*current)->text, crash_step < CalibrationStore::kCommitReplacedStep ? old_text : new_text);
     // AND no temp file survives the reopen, and the next commit works
     ASSERT_TRUE(reopened.commit(calibration_version(3)));
     EXPECT_EQ(file_bytes(reopened.current_path()), formats::format_calibration_toml(calibration_version(3)));
@@ -62,7 +59,7 @@ TEST(CrashDuringRollback, EveryStepLeavesTheOldOrTheNewFileComplete) {
     // THEN the current file is version 2 before the rename, version 1 after it
     CalibrationStore reopened({dir.path(), 3});
     ASSERT_TRUE(reopened.open());
-    EXPECT_EQ(file_bytes(reopened.current_path()), crash_step < 4 ? second : first);
+    EXPECT_EQ(file_bytes(reopened.current_path()), crash_step < CalibrationStore::kRollbackReplacedStep ? second : first);
   }
 }
 

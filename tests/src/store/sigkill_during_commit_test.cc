@@ -18,8 +18,6 @@ namespace {
 using test::calibration_version;
 using test::TempStateDir;
 
-constexpr int kCommitRenameStep = 1 + kAtomicWriteSteps + 3;
-
 TEST(SigkillDuringCommit, RestartedStoreFindsTheOldOrTheNewFileComplete) {
   const std::string old_text = formats::format_calibration_toml(calibration_version(1));
   const std::string new_text = formats::format_calibration_toml(calibration_version(2));
@@ -52,7 +50,7 @@ TEST(SigkillDuringCommit, RestartedStoreFindsTheOldOrTheNewFileComplete) {
     ASSERT_TRUE(restarted.open());
     const auto current = restarted.load_current();
     ASSERT_TRUE(current && current->has_value()) << (current ? "" : current.error().message());
-    EXPECT_EQ((*current)->text, kill_step < kCommitRenameStep ? old_text : new_text);
+    EXPECT_EQ((*current)->text, kill_step < CalibrationStore::kCommitReplacedStep ? old_text : new_text);
   }
 }
 
