@@ -1,0 +1,84 @@
+#include "sim/dataset.h"
+
+#include <algorithm>
+
+#include "sim/rng.h"
+#include "sim/sensors.h"
+#include "sim/stream_purpose.h"
+#include "sim/waypoints.h"
+
+namespace cdpr::sim {
+namespace {
+
+// A direction uniform on the sphere, times `norm`.
+Eigen::Vector3d random_vector(Rng& rng, double norm) {
+  Eigen::Vector3d v;
+  do {
+    v = Eigen::Vector3d(rng.normal(), rng.normal(), rng.normal());
+  } while (v.norm() < 1e-12);
+  return norm * v.normalized();
+}
+
+Robot nominal_robot(const TrueRobot& truth, const DatasetConfig& config) {
+  Robot nominal = truth.robot;
+  Rng rng = Rng::stream(config.seed, kStreamAnchorPerturbation);
+  for (Winch& winch : nominal.winches) winch.anchor_world += random_vector(rng, config.anchor_perturbation_m);
+  if (config.noise_scale > 0.0) {
+    nominal.noise.encoder_m *= config.noise_scale;
+    nominal.noise.force_n *= config.noise_scale;
+    nominal.noise.position_m *= config.noise_scale;
+    nominal.noise.orientation_rad *= config.noise_scale;
+  }
+  nominal.axial_stiffness_n.reset();  // elasticity is a hidden effect
+  return nominal;
+}
+
+bool taut_enough(const Equilibrium& state, double min_tension_n) {
+  return std::all_of(state.cables.begin(), state.cables.end(),
+                     [&](const CableEquilibrium& c) { return c.tension_n >= min_tension_n; });
+}
+
+}  // namespace
+
+TrueRobot make_true_robot(const DatasetConfig& config) {
+  const PresetSpec spec = preset_spec(config.preset);
+  TrueRobot robot = spec.robot;
+  robot.effects = config.effects;
+  Rng rng = Rng::stream(config.seed, kStreamEncoderOffsets);
+  for (double& offset : robot.encoder_offset_m) offset = rng.uniform(-spec.offset_range_m, spec.offset_range_m);
+  return robot;
+}
+
+Expected<SimulatedDataset, std::string> simulate_dataset(const DatasetConfig& config) {
+  if (config.pose_count < 1) return Unexpected{std::string("pose count must be at least 1")};
+  if (config.segments < 1) return Unexpected{std::string("segments must be at least 1")};
+  const PresetSpec spec = preset_spec(config.preset);
+  SimulatedDataset data;
+  data.true_robot = make_true_robot(config);
+  data.nominal = nominal_robot(data.true_robot, config);
+  data.truth = truth_of(data.true_robot);
+
+  SolverOptions options;
+  options.segments = config.segments;
+  WaypointSequence waypoints(spec, config.seed);
+  const int max_candidates = config.pose_count * config.max_candidates_per_pose;
+  for (int tried = 0; static_cast<int>(data.samples.size()) < config.pose_count; ++tried) {
+    if (tried == max_candidates) {
+      return Unexpected{"only " + std::to_string(data.samples.size()) + " of " + std::to_string(config.pose_count) +
+                        " poses have a taut equilibrium after " + std::to_string(tried) + " candidates"};
+    }
+    const Waypoint w = waypoints.next();
+    const EquilibriumResult state = solve_equilibrium(data.true_robot, w.position_world, w.yaw_rad, options);
+    if (!state || !taut_enough(*state, spec.min_tension_n)) {
+      ++data.skipped_candidates;
+      continue;
+    }
+    Rng noise = Rng::stream(config.seed, kStreamSensorNoise, static_cast<std::uint64_t>(w.candidate));
+    data.samples.push_back(
+        measure(data.true_robot, *state, config.noise_scale, noise, static_cast<int>(data.samples.size())));
+    data.states.push_back(*state);
+  }
+  return data;
+}
+
+}  // namespace cdpr::sim

@@ -1,0 +1,55 @@
+#pragma once
+// A whole simulated calibration data set: the three files of FORMATS.md
+// (robot.toml, samples.csv, truth.toml) as values, plus the true state at
+// every sample for model checks (e.g. the paper's Table I).
+//
+// Reproducible: the same config gives identical data. Random parts draw from
+// separate streams of the seed (sim/stream_purpose.h): true encoder offsets
+// (uniform +-offset range of the preset), nominal anchor perturbation,
+// waypoints, and each candidate waypoint's sensor noise, so two configs that
+// differ only in effects or noise scale share waypoints and offsets.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sim/equilibrium.h"
+#include "sim/presets.h"
+#include "sim/true_robot.h"
+#include "solver/calibration.h"
+#include "solver/robot.h"
+#include "solver/sample.h"
+#include "src/formats/expected.h"
+
+namespace cdpr::sim {
+
+struct DatasetConfig {
+  Preset preset = Preset::kLarge;
+  int pose_count = 35;
+  std::uint64_t seed = 1;
+  // robot.toml's nominal anchors = true anchors + a random vector of this norm [m].
+  double anchor_perturbation_m = 0.0;
+  HiddenEffects effects;
+  // Multiplies every sensor sigma; 0 = noiseless. robot.toml's [noise] gets
+  // the scaled sigmas (the preset's when 0, since sigmas must be > 0).
+  double noise_scale = 1.0;
+  int segments = 2000;                // sim/cable_shooting.h
+  int max_candidates_per_pose = 20;   // give up after this many candidates per wanted pose
+};
+
+struct SimulatedDataset {
+  Robot nominal;            // robot.toml
+  TrueRobot true_robot;     // the simulated robot
+  Truth truth;              // truth.toml
+  std::vector<Sample> samples;        // samples.csv, ids 0..n-1
+  std::vector<Equilibrium> states;    // true state of samples[k]
+  int skipped_candidates = 0;         // waypoints without a taut equilibrium or below the tension floor
+};
+
+Expected<SimulatedDataset, std::string> simulate_dataset(const DatasetConfig& config);
+
+// The robot simulate_dataset uses: the preset with the config's effects and
+// random true offsets.
+TrueRobot make_true_robot(const DatasetConfig& config);
+
+}  // namespace cdpr::sim
