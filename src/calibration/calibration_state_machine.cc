@@ -260,6 +260,8 @@ void CalibrationStateMachine::next_waypoint(hal::TimeUs now_us) {
   enter(CalibrationState::kSolve, now_us);
 }
 
+bool CalibrationStateMachine::owns_hardware() const { return in_motion_phase(status_.state); }
+
 bool CalibrationStateMachine::solve_pending() const {
   return status_.state == CalibrationState::kSolve && !solve_ && !solve_result_;
 }

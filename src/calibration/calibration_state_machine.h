@@ -31,7 +31,12 @@
 //            request; the reason goes to status().reason.
 //
 // While running (preflight .. sample) every step polls the hardware once
-// (HardwareMonitor) and any fault aborts. A start request (button or control
+// (HardwareMonitor: winch update, pose update, one load-cell read) and any
+// fault aborts; owns_hardware() says so, and the owner must not poll the
+// devices itself then. Otherwise (idle, solve .. done/failed) the machine
+// does not touch the devices: the owner may keep the bus serviced
+// (WinchBank::update) for diagnostics. After a run the drives stay enabled
+// and halted (holding); disabling them is the owner's choice. A start request (button or control
 // socket) while running is ignored with a note, never a restart.
 // Not thread-safe: step(), request_*() and deliver_solve_result() from one thread.
 
@@ -99,6 +104,9 @@ class CalibrationStateMachine {
   bool solve_pending() const;
   const std::vector<Sample>& samples() const { return samples_; }
   void deliver_solve_result(CalibrationResult result, hal::TimeUs now_us);
+
+  // True while step() polls the devices (preflight .. sample).
+  bool owns_hardware() const;
 
   const CalibrationStatus& status() const { return status_; }
   const WaypointPlan& plan() const { return plan_; }

@@ -46,8 +46,9 @@ TEST(CalibrationStateMachine, OneButtonPressRunsTheWholeCalibrationAndCommits) {
   EXPECT_EQ((*current)->calibration.created, "2026-11-23T08:00:00Z");
   EXPECT_EQ((*current)->calibration.samples, 6);
   EXPECT_NE(rig.current_bytes(), rig.previous_bytes);
-  // AND the winches hold still
+  // AND the winches hold still, and the owner may service the bus again
   EXPECT_TRUE(rig.winches.all_stopped());
+  EXPECT_FALSE(rig.machine->owns_hardware());
 }
 
 TEST(CalibrationStateMachine, SamplesAreTheRestPosesAndEncoders) {
@@ -171,6 +172,7 @@ TEST(CalibrationStateMachine, ButtonPressedTwiceIsIgnoredNotARestart) {
       << rig.status().note;
   EXPECT_EQ(rig.status().started_us, started_us);
   EXPECT_EQ(rig.status().waypoint, 3);
+  EXPECT_TRUE(rig.machine->owns_hardware());
   // AND the run completes normally
   ASSERT_TRUE(rig.run_to_end());
   EXPECT_EQ(rig.status().state, CalibrationState::kDone) << rig.status().reason;
