@@ -290,7 +290,6 @@ void CalibrationStateMachine::run_validate_and_commit(hal::TimeUs now_us) {
     if (utc_now_text_) calibration.created = utc_now_text_();
     if (calibration.created.empty()) calibration.created = "1970-01-01T00:00:00Z";
     calibration.robot = robot_.name;
-    calibration.model = options_.model;
     calibration.samples = static_cast<int>(samples_.size());
     enter(CalibrationState::kCommit, now_us);
     return;

@@ -24,7 +24,9 @@
 //            polls solve_pending(), runs calibrate() on samples() wherever it
 //            likes (a worker thread) and hands the result to
 //            deliver_solve_result().
-// validate   validate_fit() against the current calibration.
+// validate   validate_fit() against the current calibration; then `created`
+//            (from utc_now_text), `robot` and `samples` are filled in; the
+//            model terms are the solver's.
 // commit     CalibrationStore::commit(); a store error fails the run and the
 //            store guarantees the old file is intact.
 // abort      quick stop for a fault, halt (decelerate and hold) for an abort
@@ -67,7 +69,6 @@ struct CalibratorOptions {
   hal::TimeUs enable_timeout_us = 5'000'000;
   hal::TimeUs move_timeout_us = 600'000'000;
   hal::TimeUs settle_timeout_us = 60'000'000;
-  std::vector<std::string> model{"catenary"};  // written to calibration.toml
 };
 
 using SolveFunction = std::function<CalibrationResult(const Robot&, const std::vector<Sample>&)>;
