@@ -1,6 +1,7 @@
 #include "solver/calibrate.h"
 
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include "solver/cable_prediction.h"
@@ -30,21 +31,75 @@ std::string check_inputs(const Robot& robot, const std::vector<Sample>& samples)
 // anchors held at their nominal values; falls back to the bare guess.
 struct PoseStart {
   bool usable = false;
+  Pose world_T_platform;  // the measured pose, turned about the vertical if the statics needed it
   Eigen::Vector2d reference_force = Eigen::Vector2d::Zero();
   std::array<double, kCableCount> lengths{};
 };
 
+std::optional<Eigen::Vector2d> start_force(const Robot& robot, const Anchors& anchors, const Sample& sample,
+                                           const CalibrationOptions& o) {
+  std::optional<Eigen::Vector2d> force = refine_reference_force(
+      robot, anchors, sample, paper_reference_force_guess(robot, anchors, sample), o.height_sigma_m);
+  if (!force) {
+    force = refine_reference_force(robot, anchors, sample, rigid_reference_force_guess(robot, anchors, sample),
+                                   o.height_sigma_m);
+  }
+  return force;
+}
+
+// The cables' lines of action pass close to the platform centre, so its
+// yaw balance is weak: with anchors metres off, the measured heading may
+// admit no tension-only equilibrium. The paper (Sec. IV-C) lets a rotation
+// variable absorb this; here the start turns the pose about the vertical by
+// the smallest angle that makes every cable pull, and the pose prior pulls it
+// back as the anchors converge.
 PoseStart start_pose(const Robot& robot, const Anchors& anchors, const Sample& sample, const CalibrationOptions& o) {
-  PoseStart start;
-  const Eigen::Vector2d guess = paper_reference_force_guess(robot, anchors, sample);
-  std::optional<Eigen::Vector2d> force = refine_reference_force(robot, anchors, sample, guess, o.height_sigma_m);
-  if (!force) return start;
-  const auto cables = predict_cables(robot, anchors, measured_pose(sample), *force);
-  if (!cables) return start;
-  start.usable = true;
-  start.reference_force = *force;
-  for (int i = 0; i < kCableCount; ++i) start.lengths[i] = (*cables)[i].arc_length_m;
-  return start;
+  constexpr double kYawStepRad = 0.25 * M_PI / 180.0;
+  constexpr int kYawSteps = 120;  // up to +-30 degrees
+  // A start whose cable ends miss their attachments by less than this is
+  // taken as it is; otherwise the whole yaw range is searched for the best.
+  constexpr double kGoodEnoughHeightMissM = 0.5;
+  PoseStart best;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (int step = 0; step <= 2 * kYawSteps; ++step) {
+    const double yaw = kYawStepRad * ((step + 1) / 2) * (step % 2 ? 1.0 : -1.0);
+    Sample turned = sample;
+    turned.world_R_platform = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())) * sample.world_R_platform;
+    const std::optional<Eigen::Vector2d> force = start_force(robot, anchors, turned, o);
+    if (!force) continue;
+    const Pose pose = measured_pose(turned);
+    const auto cables = predict_cables(robot, anchors, pose, *force);
+    if (!cables) continue;
+    double worst_miss = 0.0, cost = 0.0;
+    for (int i = 0; i < kCableCount; ++i) {
+      const double miss = (*cables)[i].end_height_m - pose.transform(robot.winches[i].attachment_platform).z();
+      worst_miss = std::max(worst_miss, std::abs(miss));
+      cost += std::pow(miss / o.height_sigma_m, 2);
+    }
+    cost += std::pow(((*cables)[robot.reference_cable].tension_n - sample.force_n) / robot.noise.force_n, 2);
+    if (!std::isfinite(cost) || cost >= best_cost) continue;
+    best_cost = cost;
+    best.usable = true;
+    best.world_T_platform = pose;
+    best.reference_force = *force;
+    for (int i = 0; i < kCableCount; ++i) best.lengths[i] = (*cables)[i].arc_length_m;
+    if (step == 0 && worst_miss < kGoodEnoughHeightMissM) break;
+  }
+  if (!best.usable) {
+    // Neither guess leads to an equilibrium at any heading: search the
+    // forces at the measured heading as a last resort.
+    const std::optional<Eigen::Vector2d> feasible = search_feasible_reference_force(robot, anchors, sample, o.height_sigma_m);
+    const std::optional<Eigen::Vector2d> force =
+        feasible ? refine_reference_force(robot, anchors, sample, *feasible, o.height_sigma_m) : std::nullopt;
+    const auto cables = force ? predict_cables(robot, anchors, measured_pose(sample), *force) : std::nullopt;
+    if (cables) {
+      best.usable = true;
+      best.world_T_platform = measured_pose(sample);
+      best.reference_force = *force;
+      for (int i = 0; i < kCableCount; ++i) best.lengths[i] = (*cables)[i].arc_length_m;
+    }
+  }
+  return best;
 }
 
 std::array<double, kCableCount> straight_lengths(const Robot& robot, const Anchors& anchors, const Sample& sample) {
@@ -109,6 +164,7 @@ BuiltProblem build_calibration_problem(const Robot& robot, const std::vector<Sam
   // refused by id, never dropped silently.
   std::vector<Sample>& samples = built.samples;
   std::vector<Eigen::Vector2d> forces;
+  std::vector<Pose> start_poses;
   std::vector<std::array<double, kCableCount>> lengths;
   for (const Sample& sample : all_samples) {
     if (catenary) {
@@ -118,9 +174,11 @@ BuiltProblem build_calibration_problem(const Robot& robot, const std::vector<Sam
         continue;
       }
       forces.push_back(start.reference_force);
+      start_poses.push_back(start.world_T_platform);
       lengths.push_back(start.lengths);
     } else {
       lengths.push_back(straight_lengths(robot, nominal, sample));
+      start_poses.push_back(measured_pose(sample));
     }
     samples.push_back(sample);
   }
@@ -139,7 +197,7 @@ BuiltProblem build_calibration_problem(const Robot& robot, const std::vector<Sam
   }
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const int pose_index = static_cast<int>(k);
-    problem.add_pose(PoseKey(pose_index), measured_pose(samples[k]));
+    problem.add_pose(PoseKey(pose_index), start_poses[k]);
     problem.add_factor(std::make_unique<PosePriorFactor>(pose_index, measured_pose(samples[k]),
                                                          robot.noise.position_m, robot.noise.orientation_rad, loss));
     if (catenary) {

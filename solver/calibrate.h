@@ -25,7 +25,7 @@ struct CalibrationOptions {
   int max_iterations = 200;
   // Sigma [m] of the attachment-height consistency of Eq. (15): a model
   // identity, not a sensor, so it is held much tighter than the pose noise.
-  double height_sigma_m = 1e-3;
+  double height_sigma_m = 1e-2;
   std::function<void(const IterationSummary&)> progress;  // may be empty
 };
 

@@ -18,6 +18,20 @@ namespace cdpr {
 Eigen::Vector2d paper_reference_force_guess(const Robot& robot, const std::array<Eigen::Vector3d, kCableCount>& anchors,
                                             const Sample& sample);
 
+// Fallback when Eq. (17)-(18) leaves the statics unusable: the least-squares
+// tensions of four straight cables along their chords carrying the weight,
+// split into the reference cable's horizontal and vertical parts.
+Eigen::Vector2d rigid_reference_force_guess(const Robot& robot, const std::array<Eigen::Vector3d, kCableCount>& anchors,
+                                            const Sample& sample);
+
+// Last resort when both guesses leave a cable pushing: the best point of a
+// grid over (f_h, f_v) at which every cable pulls, by the height and force
+// residuals. Empty when no such point exists (the nominal geometry cannot
+// hold the measured pose).
+std::optional<Eigen::Vector2d> search_feasible_reference_force(const Robot& robot,
+                                                               const std::array<Eigen::Vector3d, kCableCount>& anchors,
+                                                               const Sample& sample, double sigma_height_m);
+
 // Refines (f_h, f_v) of the reference cable at one pose, anchors held fixed,
 // by damped Gauss-Newton on the height (Eq. 15) and force (Eq. 16)
 // residuals, starting from `guess`. Empty when the statics cannot be

@@ -14,7 +14,7 @@ struct SolveArgs {
   std::string truth_path;  // optional: compare with a simulator's truth.toml
   std::string model = "catenary";
   double huber_width = 0.0;
-  double height_sigma_m = 1e-3;
+  double height_sigma_m = 1e-2;
   int max_iterations = 200;
   bool quiet = false;
 };
