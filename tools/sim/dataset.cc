@@ -52,7 +52,11 @@ TrueRobot make_true_robot(const DatasetConfig& config) {
 Expected<SimulatedDataset, std::string> simulate_dataset(const DatasetConfig& config) {
   if (config.pose_count < 1) return Unexpected{std::string("pose count must be at least 1")};
   if (config.segments < 1) return Unexpected{std::string("segments must be at least 1")};
-  const PresetSpec spec = preset_spec(config.preset);
+  PresetSpec spec = preset_spec(config.preset);
+  if (config.workspace_min && config.workspace_max) {
+    spec.workspace_min = *config.workspace_min;
+    spec.workspace_max = *config.workspace_max;
+  }
   SimulatedDataset data;
   data.true_robot = make_true_robot(config);
   data.nominal = nominal_robot(data.true_robot, config);

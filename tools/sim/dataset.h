@@ -10,6 +10,7 @@
 // differ only in effects or noise scale share waypoints and offsets.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,9 @@ struct DatasetConfig {
   // Multiplies every sensor sigma; 0 = noiseless. robot.toml's [noise] gets
   // the scaled sigmas (the preset's when 0, since sigmas must be > 0).
   double noise_scale = 1.0;
+  // Waypoint box (platform origin, world) instead of the preset's, e.g. the
+  // wider spread a calibration plan uses for observability; both or neither.
+  std::optional<Eigen::Vector3d> workspace_min, workspace_max;
   int segments = 2000;                // sim/cable_shooting.h
   int max_candidates_per_pose = 20;   // give up after this many candidates per wanted pose
 };

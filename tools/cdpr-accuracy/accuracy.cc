@@ -1,0 +1,85 @@
+#include "cdpr-accuracy/accuracy.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sim/dataset.h"
+
+namespace cdpr::accuracy {
+
+RunResult run_case(const Case& c, std::uint64_t seed) {
+  RunResult run;
+  run.seed = seed;
+  sim::DatasetConfig config;
+  config.preset = c.preset;
+  config.pose_count = c.poses;
+  config.seed = seed;
+  config.anchor_perturbation_m = c.anchor_perturbation_m;
+  config.noise_scale = c.noise_scale;
+  config.workspace_min = c.workspace_min;
+  config.workspace_max = c.workspace_max;
+  const auto data = sim::simulate_dataset(config);
+  if (!data) {
+    run.message = "simulation failed: " + data.error();
+    return run;
+  }
+  CalibrationOptions options;
+  options.cable_model = c.model;
+  const CalibrationResult result = calibrate(data->nominal, data->samples, options);
+  run.ok = result.ok;
+  run.message = result.message;
+  run.iterations = result.solver.iterations;
+  const std::vector<WinchTruth>& truth = data->truth.winches;
+  const int n = static_cast<int>(truth.size());
+  for (int i = 0; i < n; ++i) {
+    if (!result.ok) {
+      // Scored as no calibration at all: the nominal guess stays in force.
+      run.anchor_error_m += (data->nominal.winches[i].anchor_world - truth[i].anchor_world).norm() / n;
+      run.offset_error_m += std::abs(truth[i].offset_m) / n;
+      continue;
+    }
+    const WinchCalibration& w = result.calibration.winches[i];
+    const Eigen::Vector3d error = w.anchor_world - truth[i].anchor_world;
+    const double offset_error = w.offset_m - truth[i].offset_m;
+    run.anchor_error_m += error.norm() / n;
+    run.offset_error_m += std::abs(offset_error) / n;
+    run.normalised_sq_sum += error.cwiseQuotient(w.anchor_sigma).squaredNorm() + std::pow(offset_error / w.offset_sigma_m, 2);
+    run.normalised_count += 4;
+  }
+  return run;
+}
+
+Distribution distribution(std::vector<double> values) {
+  Distribution d;
+  if (values.empty()) return d;
+  std::sort(values.begin(), values.end());
+  for (double v : values) d.mean += v / static_cast<double>(values.size());
+  const auto at = [&](double q) { return values[std::min(values.size() - 1, static_cast<std::size_t>(q * (values.size() - 1) + 0.5))]; };
+  d.median = at(0.5);
+  d.p90 = at(0.9);
+  d.worst = values.back();
+  return d;
+}
+
+Summary summarise(const std::vector<RunResult>& runs) {
+  Summary s;
+  s.runs = static_cast<int>(runs.size());
+  std::vector<double> anchors, offsets;
+  double sq = 0.0, iterations = 0.0;
+  int count = 0;
+  for (const RunResult& r : runs) {
+    anchors.push_back(r.anchor_error_m);
+    offsets.push_back(r.offset_error_m);
+    if (!r.ok) ++s.failures;
+    sq += r.normalised_sq_sum;
+    count += r.normalised_count;
+    iterations += r.iterations;
+  }
+  s.anchor = distribution(anchors);
+  s.offset = distribution(offsets);
+  s.normalised_rms = count ? std::sqrt(sq / count) : 0.0;
+  s.mean_iterations = runs.empty() ? 0.0 : iterations / runs.size();
+  return s;
+}
+
+}  // namespace cdpr::accuracy
