@@ -214,8 +214,10 @@ BuiltProblem build_calibration_problem(const Robot& robot, const std::vector<Sam
   return built;
 }
 
-CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& all_samples,
-                            const CalibrationOptions& options) {
+namespace {
+
+CalibrationResult calibrate_once(const Robot& robot, const std::vector<Sample>& all_samples,
+                                 const CalibrationOptions& options) {
   CalibrationResult result;
   BuiltProblem built = build_calibration_problem(robot, all_samples, options);
   result.rejected_samples = built.rejected_samples;
@@ -263,6 +265,28 @@ CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& all_s
   result.ok = covariance.size() > 0;
   if (!result.ok) result.message += "; the fit's information matrix is singular: parameters not observable";
   return result;
+}
+
+}  // namespace
+
+CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& samples, const CalibrationOptions& options) {
+  CalibrationResult first = calibrate_once(robot, samples, options);
+  if (first.ok || options.cable_model != CableModelKind::kCatenary) return first;
+  // A tight Eq. (15) makes the cost landscape narrow; far from the solution
+  // LM can stall where the anchors are unobservable. Continuation: solve with
+  // a ten times looser height consistency from the nominal anchors, then
+  // with the requested one from there.
+  CalibrationOptions loose = options;
+  loose.height_sigma_m *= 10.0;
+  const CalibrationResult coarse = calibrate_once(robot, samples, loose);
+  if (coarse.calibration.winches.empty()) return first;
+  Robot restart = robot;
+  for (int i = 0; i < kCableCount; ++i) restart.winches[i].anchor_world = coarse.calibration.winches[i].anchor_world;
+  CalibrationResult second = calibrate_once(restart, samples, options);
+  if (!second.ok) return first;
+  second.message += " (after a restart with a looser height consistency: the first solve stopped where the anchors "
+                    "were unobservable)";
+  return second;
 }
 
 }  // namespace cdpr
