@@ -52,7 +52,7 @@ bool write_file(const std::filesystem::path& path, const std::string& text) {
 struct Args {
   std::string preset = "large";
   std::string out_dir;
-  std::string encoder_scale, com_offset, wind;
+  std::string encoder_scale, com_offset, wind, workspace;
   std::uint64_t seed = 1;
 };
 
@@ -87,6 +87,9 @@ int main(int argc, char** argv) {
   app.add_option("--pulley-radius", config.effects.pulley_radius_m, "hidden swivel-pulley radius [m] (DESIGN.md)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--wind", args.wind, "unknown effect: constant force fx,fy,fz [N, world] on the platform at its CoM");
+  app.add_option("--workspace", args.workspace,
+                 "waypoint box xmin,ymin,zmin,xmax,ymax,zmax [m] of the platform origin (default: the preset's, "
+                 "which spans the paper's Table I ranges; a wider box makes the anchors better observable)");
   app.add_option("--noise-scale", config.noise_scale,
                  "multiplies every sensor sigma (encoder 10 mm, force 5 N large / 1 N small, pose 5 mm, 0.01 rad); 0 = noiseless")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
@@ -112,6 +115,15 @@ int main(int argc, char** argv) {
       return 1;
     }
     *target = Eigen::Vector3d(values[0], values[1], values[2]);
+  }
+
+  if (!args.workspace.empty()) {
+    if (!parse_list(args.workspace, 6, values) || values.size() != 6) {
+      std::fprintf(stderr, "cdpr-sim: --workspace: expected 6 comma-separated numbers xmin,ymin,zmin,xmax,ymax,zmax\n");
+      return 1;
+    }
+    config.workspace_min = Eigen::Vector3d(values[0], values[1], values[2]);
+    config.workspace_max = Eigen::Vector3d(values[3], values[4], values[5]);
   }
 
   const auto data = cdpr::sim::simulate_dataset(config);
