@@ -45,9 +45,11 @@ TEST(Accuracy, LargeRobotWithWideWaypointsBeatsPaperAndRigidModel) {
     rigid.push_back(run_case(c, seed));
   }
   const Summary cat = summarise(catenary), rig = summarise(rigid);
-  // THEN the catenary fit is better than the paper's 0.19 m and far better than the rigid model,
-  // and its sigmas are honest
-  EXPECT_LT(cat.anchor.mean, 0.19);
+  // THEN the catenary fit meets issue 4's 0.10 m (the paper reports 0.19 m), is far better than
+  // the rigid model, and its sigmas are honest
+  EXPECT_LE(cat.anchor.mean, 0.10);
+  EXPECT_LE(cat.offset.mean, 0.10);
+  EXPECT_EQ(cat.failures, 0);
   EXPECT_LT(cat.anchor.mean * 5.0, rig.anchor.mean);
   EXPECT_GT(cat.normalised_rms, 0.4);
   EXPECT_LT(cat.normalised_rms, 2.0);
