@@ -10,7 +10,7 @@ PREFIX     ?= /usr/local
 # Debian packages the project needs; see README.md for why each is here.
 DEB_PACKAGES := build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev \
                 libmodbus-dev libsystemd-dev libtomlplusplus-dev libcli11-dev \
-                libgtest-dev libgmock-dev libbenchmark-dev libgpiod-dev
+                libgtest-dev libgmock-dev libbenchmark-dev libgpiod-dev systemd
 # Ceres is used by the benchmark comparison only, never linked into the daemon.
 BENCH_PACKAGES := libceres-dev
 
