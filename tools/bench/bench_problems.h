@@ -1,0 +1,40 @@
+#pragma once
+// The benchmark's problems: one simulated large-robot data set per pose
+// count (catenary model, nominal anchors 10 m off), and the calibration's
+// factor graph at its data-driven start, built exactly as calibrate() does.
+// Both solvers start from the same state and stop at the same tolerances.
+
+#include <string>
+#include <vector>
+
+#include <ceres/solver.h>
+
+#include "solver/calibrate.h"
+#include "solver/levenberg_marquardt.h"
+#include "solver/robot.h"
+#include "solver/sample.h"
+
+namespace cdpr::bench {
+
+struct BenchData {
+  Robot robot;  // nominal (robot.toml)
+  std::vector<Sample> samples;
+};
+
+// Simulated once per pose count and cached (simulation is slow and not
+// what is measured). Aborts with a message when the simulator fails.
+const BenchData& bench_data(int pose_count);
+
+// build_calibration_problem() with default CalibrationOptions; aborts when refused.
+BuiltProblem build_problem(const BenchData& data);
+
+// Our solver's options for the comparison: defaults, 200 iterations like calibrate().
+SolverOptions our_options();
+
+enum class CeresLinearSolver { kSparseNormalCholesky, kSparseSchur };
+std::string to_string(CeresLinearSolver solver);
+
+// Ceres LM with our tolerances, initial radius and iteration cap, one thread.
+ceres::Solver::Options ceres_options(CeresLinearSolver solver);
+
+}  // namespace cdpr::bench

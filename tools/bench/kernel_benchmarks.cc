@@ -1,0 +1,102 @@
+// The solver's kernels on the 35-pose problem: one factor evaluation, one
+// numeric refactorisation, one covariance extraction.
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "bench_problems.h"
+#include "solver/keys.h"
+#include "solver/normal_equations.h"
+#include "solver/sparse_cholesky.h"
+#include "solver/static_pose_factor.h"
+
+namespace cdpr::bench {
+namespace {
+
+constexpr int kKernelPoses = 35;
+
+// One StaticPoseFactor::evaluate with all Jacobians, at the start state.
+void BM_StaticPoseFactorEvaluate(benchmark::State& state) {
+  BuiltProblem built = build_problem(bench_data(kKernelPoses));
+  const Problem& problem = *built.problem;
+  const Factor* factor = nullptr;
+  for (const auto& f : problem.factors()) {
+    if (dynamic_cast<const StaticPoseFactor*>(f.get()) != nullptr) {
+      factor = f.get();
+      break;
+    }
+  }
+  if (factor == nullptr) {
+    state.SkipWithError("no StaticPoseFactor in the problem");
+    return;
+  }
+  std::vector<const double*> parameters;
+  std::vector<std::vector<double>> jacobian_storage;
+  std::vector<double*> jacobians;
+  for (const Key& key : factor->keys()) {
+    const Problem::Variable& v = problem.variables()[problem.variable_index(key)];
+    parameters.push_back(problem.state().data() + v.ambient_offset);
+    jacobian_storage.emplace_back(factor->residual_dim() * v.tangent_dim);
+  }
+  for (auto& j : jacobian_storage) jacobians.push_back(j.data());
+  std::vector<double> residual(factor->residual_dim());
+  double cost = 0.0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(factor->evaluate(parameters.data(), residual.data(), jacobians.data(), &cost));
+    benchmark::ClobberMemory();
+  }
+}
+
+// SparseCholesky::factorize of the damped J^T J at the start, in the
+// solver's own pattern (NormalEquations), on a SparseCholesky constructed
+// like the solver's: the numeric refactorisation of one LM iteration
+// (symbolic analysis done once, outside the loop).
+void BM_NumericRefactorisation(benchmark::State& state) {
+  BuiltProblem built = build_problem(bench_data(kKernelPoses));
+  NormalEquations normal(*built.problem);
+  double cost = 0.0;
+  int failed = -1;
+  if (!normal.evaluate(built.problem->state().data(), 0, &cost, &failed)) {
+    state.SkipWithError("factor not evaluable at the start");
+    return;
+  }
+  std::vector<double> jtj(normal.nonzeros()), gradient(normal.columns());
+  normal.accumulate(0, jtj.data(), gradient.data());
+  // The LM's damping at its initial radius 1e4: D / radius, D = diag clamped.
+  const double radius = our_options().initial_trust_radius;
+  for (int c = 0; c < normal.columns(); ++c) {
+    double& d = jtj[normal.diagonal(c)];
+    d += std::clamp(d, 1e-6, 1e32) / radius;
+  }
+  SparseCholesky cholesky(normal.columns(), normal.column_starts(), normal.row_indices());
+  std::string message;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(cholesky.factorize(jtj.data(), &message));
+  }
+  state.counters["columns"] = normal.columns();
+  state.counters["nonzeros"] = normal.nonzeros();
+}
+
+// LevenbergMarquardt::covariance of the 4 anchors and 4 offsets (16
+// tangent dimensions) at the solution.
+void BM_Covariance(benchmark::State& state) {
+  BuiltProblem built = build_problem(bench_data(kKernelPoses));
+  LevenbergMarquardt lm(*built.problem, our_options());
+  lm.solve();
+  std::vector<Key> keys;
+  for (int i = 0; i < kCableCount; ++i) keys.push_back(AnchorKey(i));
+  for (int i = 0; i < kCableCount; ++i) keys.push_back(OffsetKey(i));
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(lm.covariance(keys));
+  }
+}
+
+BENCHMARK(BM_StaticPoseFactorEvaluate)->Unit(benchmark::kNanosecond);
+BENCHMARK(BM_NumericRefactorisation)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Covariance)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+}  // namespace cdpr::bench

@@ -1,0 +1,84 @@
+// End-to-end and solve-only timings, ours against Ceres, per pose count.
+// Every run starts from the identical data-driven start (same data set, same
+// build, or the saved start state restored) and records its time, iteration
+// count and final cost for the summary table.
+
+#include <chrono>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "bench_problems.h"
+#include "solvers.h"
+#include "summary.h"
+
+namespace cdpr::bench {
+namespace {
+
+// Benchmark argument "solver": 0 ours, 1 Ceres sparse normal Cholesky, 2 Ceres sparse Schur.
+constexpr int kOurs = 0;
+CeresLinearSolver ceres_solver(int solver) {
+  return solver == 1 ? CeresLinearSolver::kSparseNormalCholesky : CeresLinearSolver::kSparseSchur;
+}
+
+std::string series_name(int solver) { return solver == kOurs ? "ours" : to_string(ceres_solver(solver)); }
+
+RunRecord solve_with(int solver, Problem& problem) {
+  return solver == kOurs ? solve_ours(problem) : solve_ceres(problem, ceres_solver(solver));
+}
+
+void report(benchmark::State& state, const RunRecord& last) {
+  state.counters["iterations"] = last.iterations;
+  state.counters["final_cost"] = last.final_cost;
+}
+
+// Build problem + construct solver + solve.
+void BM_EndToEnd(benchmark::State& state) {
+  const int poses = static_cast<int>(state.range(0));
+  const int solver = static_cast<int>(state.range(1));
+  const BenchData& data = bench_data(poses);
+  RunRecord run;
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    BuiltProblem built = build_problem(data);
+    run = solve_with(solver, *built.problem);
+    run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    record(series_name(solver), "e2e", poses, run);
+  }
+  report(state, run);
+  state.SetLabel(series_name(solver));
+}
+
+// Construct solver + solve, the problem built once; the start state is
+// restored before every run (a copy of a few thousand doubles).
+void BM_Solve(benchmark::State& state) {
+  const int poses = static_cast<int>(state.range(0));
+  const int solver = static_cast<int>(state.range(1));
+  BuiltProblem built = build_problem(bench_data(poses));
+  const std::vector<double> start_state = built.problem->state();
+  RunRecord run;
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    built.problem->state() = start_state;
+    run = solve_with(solver, *built.problem);
+    run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    record(series_name(solver), "solve", poses, run);
+  }
+  report(state, run);
+  state.SetLabel(series_name(solver));
+}
+
+void pose_counts_and_solvers(benchmark::internal::Benchmark* b) {
+  for (int poses : {9, 35, 109, 1000}) {
+    for (int solver : {0, 1, 2}) {
+      b->Args({poses, solver});
+    }
+  }
+  b->ArgNames({"poses", "solver"})->Unit(benchmark::kMillisecond);
+}
+
+BENCHMARK(BM_EndToEnd)->Apply(pose_counts_and_solvers);
+BENCHMARK(BM_Solve)->Apply(pose_counts_and_solvers);
+
+}  // namespace
+}  // namespace cdpr::bench

@@ -1,0 +1,80 @@
+#include "summary.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+#include <tuple>
+#include <vector>
+
+namespace cdpr::bench {
+namespace {
+
+using SeriesKey = std::tuple<std::string, std::string, int>;  // series, phase, poses
+
+std::map<SeriesKey, std::vector<RunRecord>>& records() {
+  static std::map<SeriesKey, std::vector<RunRecord>> all;
+  return all;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+struct Stats {
+  bool present = false;
+  double ms = std::nan("");
+  int iterations = 0;
+  double final_cost = std::nan("");
+};
+
+Stats stats(const std::string& series, const std::string& phase, int poses) {
+  const auto found = records().find({series, phase, poses});
+  if (found == records().end() || found->second.empty()) return {};
+  std::vector<double> seconds;
+  for (const RunRecord& r : found->second) seconds.push_back(r.seconds);
+  // Every run starts from the same state, so iterations and cost are the
+  // same in all of them; the last one stands for all.
+  const RunRecord& last = found->second.back();
+  return {true, 1e3 * median(seconds), last.iterations, last.final_cost};
+}
+
+}  // namespace
+
+void record(const std::string& series, const std::string& phase, int poses, const RunRecord& run) {
+  records()[{series, phase, poses}].push_back(run);
+}
+
+void print_summary() {
+  std::set<int> pose_counts;
+  for (const auto& [key, runs] : records()) pose_counts.insert(std::get<2>(key));
+  if (pose_counts.empty()) return;
+
+  std::printf("\nSummary (medians of all recorded runs; Ceres single-threaded, SuiteSparse)\n");
+  std::printf("%6s %-12s %6s %16s %10s %10s %10s %12s %12s\n", "poses", "solver", "iters", "final cost",
+              "rel diff", "e2e ms", "solve ms", "ms/iter", "e2e ratio");
+  for (int poses : pose_counts) {
+    const Stats ours = stats("ours", "e2e", poses);
+    const Stats ours_solve = stats("ours", "solve", poses);
+    for (const char* series : {"ours", "ceres_snc", "ceres_schur"}) {
+      const Stats e2e = stats(series, "e2e", poses);
+      const Stats solve = stats(series, "solve", poses);
+      if (!e2e.present && !solve.present) continue;
+      const Stats& any = e2e.present ? e2e : solve;
+      const Stats& reference = ours.present ? ours : ours_solve;
+      const double rel_diff = std::abs(any.final_cost - reference.final_cost) /
+                              std::max(std::abs(reference.final_cost), 1e-300);
+      const double per_iteration = solve.present && solve.iterations > 0 ? solve.ms / solve.iterations : std::nan("");
+      std::printf("%6d %-12s %6d %16.10e %10.2e %10.3f %10.3f %12.4f %11.2fx\n", poses, series, any.iterations,
+                  any.final_cost, rel_diff, e2e.ms, solve.ms, per_iteration, e2e.ms / ours.ms);
+    }
+  }
+  std::printf("rel diff: |cost - ours| / ours (must be < 1e-6); e2e ratio: this solver's / ours (e2e = build "
+              "problem + construct solver + solve; solve = construct solver + solve)\n");
+}
+
+}  // namespace cdpr::bench
