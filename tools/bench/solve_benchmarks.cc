@@ -49,6 +49,20 @@ void BM_EndToEnd(benchmark::State& state) {
   state.SetLabel(series_name(solver));
 }
 
+// Build problem only (build_calibration_problem: the data-driven start of
+// every pose), the part both solvers' end-to-end runs share.
+void BM_BuildProblem(benchmark::State& state) {
+  const int poses = static_cast<int>(state.range(0));
+  const BenchData& data = bench_data(poses);
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    BuiltProblem built = build_problem(data);
+    benchmark::DoNotOptimize(built.problem.get());
+    record("build", "e2e", poses,
+           {std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 0, 0.0});
+  }
+}
+
 // Construct solver + solve, the problem built once; the start state is
 // restored before every run (a copy of a few thousand doubles).
 void BM_Solve(benchmark::State& state) {
@@ -77,6 +91,7 @@ void pose_counts_and_solvers(benchmark::internal::Benchmark* b) {
   b->ArgNames({"poses", "solver"})->Unit(benchmark::kMillisecond);
 }
 
+BENCHMARK(BM_BuildProblem)->ArgName("poses")->Arg(9)->Arg(35)->Arg(109)->Arg(1000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_EndToEnd)->Apply(pose_counts_and_solvers);
 BENCHMARK(BM_Solve)->Apply(pose_counts_and_solvers);
 

@@ -73,6 +73,10 @@ void print_summary() {
                   any.final_cost, rel_diff, e2e.ms, solve.ms, per_iteration, e2e.ms / ours.ms);
     }
   }
+  for (int poses : pose_counts) {
+    const Stats build = stats("build", "e2e", poses);
+    if (build.present) std::printf("%6d build problem only (shared by all e2e runs): %.3f ms\n", poses, build.ms);
+  }
   std::printf("rel diff: |cost - ours| / ours (must be < 1e-6); e2e ratio: this solver's / ours (e2e = build "
               "problem + construct solver + solve; solve = construct solver + solve)\n");
 }
