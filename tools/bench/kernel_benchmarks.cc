@@ -94,6 +94,17 @@ void BM_Covariance(benchmark::State& state) {
   }
 }
 
+// Our solver's construction alone (pattern of J^T J, symbolic analysis,
+// scratch): the setup part of BM_Solve, per pose count.
+void BM_ConstructOurSolver(benchmark::State& state) {
+  BuiltProblem built = build_problem(bench_data(static_cast<int>(state.range(0))));
+  for (auto _ : state) {
+    LevenbergMarquardt lm(*built.problem, our_options());
+    benchmark::DoNotOptimize(&lm);
+  }
+}
+
+BENCHMARK(BM_ConstructOurSolver)->ArgName("poses")->Arg(35)->Arg(1000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_StaticPoseFactorEvaluate)->Unit(benchmark::kNanosecond);
 BENCHMARK(BM_NumericRefactorisation)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Covariance)->Unit(benchmark::kMicrosecond);
