@@ -1,0 +1,170 @@
+#include "src/daemon/control_server.h"
+
+#include <fcntl.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+
+#include "src/control/control_request.h"
+#include "src/control/control_response.h"
+
+namespace cdpr::daemon {
+namespace {
+
+hal::Status errno_status(const std::string& path, const char* operation) {
+  return hal::Status(hal::ErrorCode::kIoError,
+                     "control socket " + path + ": " + operation + ": " + std::strerror(errno));
+}
+
+// A socket file left behind by a crashed daemon is ours to replace; any other
+// file at the path is somebody else's and must not be deleted.
+hal::Status remove_stale_socket(const std::string& path) {
+  struct stat info {};
+  if (lstat(path.c_str(), &info) != 0) {
+    if (errno == ENOENT) return hal::Status::Ok();
+    return errno_status(path, "lstat");
+  }
+  if (!S_ISSOCK(info.st_mode)) {
+    return hal::Status(hal::ErrorCode::kInvalidArgument,
+                       "control socket " + path + ": a file that is not a socket is in the way");
+  }
+  if (unlink(path.c_str()) != 0) return errno_status(path, "unlink stale socket");
+  return hal::Status::Ok();
+}
+
+}  // namespace
+
+ControlServer::Client::Client(int client_fd)
+    : fd(client_fd), lines(control::kMaxRequestBytes + 1 /* a "\r" before "\n" is allowed */) {}
+
+hal::Result<std::unique_ptr<ControlServer>> ControlServer::listen(const std::string& path, Handler handler,
+                                                                 unsigned mode) {
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  if (path.empty() || path.size() >= sizeof(address.sun_path)) {
+    return hal::Status(hal::ErrorCode::kInvalidArgument,
+                       "control socket path '" + path + "' is empty or longer than " +
+                           std::to_string(sizeof(address.sun_path) - 1) + " bytes");
+  }
+  std::memcpy(address.sun_path, path.c_str(), path.size() + 1);
+  if (hal::Status removed = remove_stale_socket(path); !removed.ok()) return removed;
+
+  const int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  if (fd < 0) return errno_status(path, "socket");
+  if (bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) != 0) {
+    hal::Status status = errno_status(path, "bind");
+    close(fd);
+    return status;
+  }
+  // Clients are the robot's operators (group of the socket); nobody else.
+  if (chmod(path.c_str(), static_cast<mode_t>(mode)) != 0 || ::listen(fd, 16) != 0) {
+    hal::Status status = errno_status(path, "chmod/listen");
+    close(fd);
+    unlink(path.c_str());
+    return status;
+  }
+  return std::unique_ptr<ControlServer>(new ControlServer(fd, path, std::move(handler)));
+}
+
+ControlServer::ControlServer(int listen_fd, std::string path, Handler handler)
+    : listen_fd_(listen_fd), path_(std::move(path)), handler_(std::move(handler)) {}
+
+ControlServer::~ControlServer() {
+  for (const auto& client : clients_) close(client->fd);
+  close(listen_fd_);
+  unlink(path_.c_str());
+}
+
+void ControlServer::append_poll_fds(std::vector<pollfd>& fds) const {
+  fds.push_back({listen_fd_, POLLIN, 0});
+  for (const auto& client : clients_) {
+    short events = client->read_closed ? 0 : POLLIN;
+    if (!client->output.empty()) events |= POLLOUT;
+    fds.push_back({client->fd, events, 0});
+  }
+}
+
+void ControlServer::service(const std::vector<pollfd>& fds) {
+  for (const pollfd& entry : fds) {
+    if (entry.revents == 0) continue;
+    if (entry.fd == listen_fd_) {
+      accept_clients();
+      continue;
+    }
+    const auto it = std::find_if(clients_.begin(), clients_.end(),
+                                 [&](const auto& client) { return client->fd == entry.fd; });
+    if (it == clients_.end()) continue;
+    Client& client = **it;
+    if (entry.revents & (POLLIN | POLLHUP | POLLERR)) read_from(client);
+    if (!client.output.empty()) write_to(client);
+  }
+  std::erase_if(clients_, [](const auto& client) {
+    const bool done = client->broken || (client->read_closed && client->output.empty());
+    if (done) close(client->fd);
+    return done;
+  });
+}
+
+void ControlServer::accept_clients() {
+  // Drain the backlog: several clients may have connected since the last poll.
+  for (;;) {
+    const int fd = accept4(listen_fd_, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
+    if (fd < 0) return;  // EAGAIN (backlog empty) or a transient error: next poll
+    if (clients_.size() >= kMaxClients) {
+      const std::string busy = control::format_error_response("too many control clients; try again later");
+      [[maybe_unused]] const ssize_t ignored = send(fd, busy.data(), busy.size(), MSG_NOSIGNAL);
+      close(fd);
+      ++counters_.refused;
+      continue;
+    }
+    clients_.push_back(std::make_unique<Client>(fd));
+    ++counters_.accepted;
+  }
+}
+
+void ControlServer::read_from(Client& client) {
+  char buffer[kReadChunkBytes];
+  // One chunk per service call keeps a chatty client from starving the loop.
+  const ssize_t got = recv(client.fd, buffer, sizeof(buffer), 0);
+  if (got == 0) {
+    client.read_closed = true;
+    return;
+  }
+  if (got < 0) {
+    if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) client.broken = true;
+    return;
+  }
+  client.lines.feed(
+      std::string_view(buffer, static_cast<std::size_t>(got)),
+      [&](std::string_view line) {
+        ++counters_.requests;
+        client.output += handler_(line);
+      },
+      [&] {
+        client.output += control::format_error_response("request longer than " +
+                                                        std::to_string(control::kMaxRequestBytes) + " bytes");
+      });
+  if (client.output.size() > kMaxPendingOutputBytes) {
+    client.broken = true;
+    ++counters_.dropped;
+  }
+}
+
+void ControlServer::write_to(Client& client) {
+  const ssize_t sent = send(client.fd, client.output.data(), client.output.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+  if (sent < 0) {
+    if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
+      client.broken = true;
+      ++counters_.dropped;
+    }
+    return;
+  }
+  client.output.erase(0, static_cast<std::size_t>(sent));
+}
+
+}  // namespace cdpr::daemon

@@ -1,0 +1,99 @@
+#pragma once
+// The daemon's control socket: a Unix stream socket (mode 0660, e.g.
+// /run/cdpr-calib/control) serving many clients at once without ever
+// blocking the daemon loop. Each client sends request lines
+// (src/control/control_request.h); the handler answers each with one
+// response line, written back in order.
+//
+// Integration: the owner's event loop asks for the descriptors to watch
+// (append_poll_fds), calls poll() with its own timeout together with its other
+// descriptors, then hands the results back (service). Everything is
+// non-blocking; a slow or dead client only costs its own connection.
+//
+// Bounds (a client can never make the daemon buffer without limit): requests
+// are cut by LineAssembler (an overlong line gets an error response and is
+// skipped), at most kMaxClients connections (one more is told so and closed),
+// at most kMaxPendingOutputBytes unsent response bytes per client (a client
+// that does not read is dropped).
+//
+// Ownership: owns its listening and client sockets; the destructor closes
+// them and removes the socket path it created. Not thread-safe: one thread
+// (the daemon loop) calls everything, and the handler runs on that thread.
+
+#include <poll.h>
+
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "hal/status.h"
+#include "src/control/line_assembler.h"
+
+namespace cdpr::daemon {
+
+class ControlServer {
+ public:
+  static constexpr std::size_t kMaxClients = 32;
+  static constexpr std::size_t kMaxPendingOutputBytes = 1 << 20;
+  static constexpr std::size_t kReadChunkBytes = 4096;
+
+  // Answers one request line (without its "\n") with one response line
+  // (with its "\n").
+  using Handler = std::function<std::string(std::string_view request_line)>;
+
+  // Binds and listens at `path` (a stale socket left by a crash is removed;
+  // any other file there is refused) and sets its mode to `mode`.
+  // Errors: kInvalidArgument (path too long, not a socket in the way),
+  // kIoError (socket, bind, listen, chmod), each naming the path and errno.
+  static hal::Result<std::unique_ptr<ControlServer>> listen(const std::string& path, Handler handler,
+                                                           unsigned mode = 0660);
+  ~ControlServer();
+  ControlServer(const ControlServer&) = delete;
+  ControlServer& operator=(const ControlServer&) = delete;
+
+  // Appends the listening socket and every client (POLLIN, plus POLLOUT when
+  // it has unsent output).
+  void append_poll_fds(std::vector<pollfd>& fds) const;
+  // Accepts, reads, answers and writes for every entry of `fds` that is
+  // ours and ready (entries of other owners are ignored), then drops closed
+  // clients. Never blocks.
+  void service(const std::vector<pollfd>& fds);
+
+  std::size_t client_count() const { return clients_.size(); }
+  const std::string& path() const { return path_; }
+
+  // Counters for diagnostics.
+  struct Counters {
+    unsigned long long accepted = 0;
+    unsigned long long refused = 0;  // over kMaxClients
+    unsigned long long requests = 0;
+    unsigned long long dropped = 0;  // output over the limit or i/o error
+  };
+  const Counters& counters() const { return counters_; }
+
+ private:
+  struct Client {
+    int fd = -1;
+    control::LineAssembler lines;
+    std::string output;      // responses not yet written
+    bool read_closed = false;  // peer sent EOF: close once output is flushed
+    bool broken = false;       // close now
+    explicit Client(int client_fd);
+  };
+
+  ControlServer(int listen_fd, std::string path, Handler handler);
+  void accept_clients();
+  void read_from(Client& client);
+  void write_to(Client& client);
+
+  int listen_fd_;
+  std::string path_;
+  Handler handler_;
+  std::vector<std::unique_ptr<Client>> clients_;
+  Counters counters_;
+};
+
+}  // namespace cdpr::daemon

@@ -1,0 +1,233 @@
+// The control socket server against a stub handler, through real Unix
+// sockets: ordering, many concurrent clients, bounds, permissions, cleanup.
+
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "src/daemon/control_server.h"
+
+namespace cdpr::daemon {
+namespace {
+
+class TempDir {
+ public:
+  TempDir() {
+    char pattern[] = "/tmp/cdpr-control-XXXXXX";
+    path_ = mkdtemp(pattern);
+  }
+  ~TempDir() { std::filesystem::remove_all(path_); }
+  std::string operator/(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
+
+// Answers "echo <n>" with "<n>" and counts requests.
+struct StubHandler {
+  int calls = 0;
+  std::string operator()(std::string_view line) {
+    ++calls;
+    return "{\"echo\":\"" + std::string(line) + "\"}\n";
+  }
+};
+
+int connect_to(const std::string& path) {
+  const int fd = socket(AF_UNIX, SOCK_STREAM, 0);
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  std::snprintf(address.sun_path, sizeof(address.sun_path), "%s", path.c_str());
+  if (connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) != 0) {
+    close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+void send_text(int fd, const std::string& text) {
+  ASSERT_EQ(send(fd, text.data(), text.size(), MSG_NOSIGNAL), static_cast<ssize_t>(text.size()));
+}
+
+// Runs the server's part of the event loop for `rounds` polls of 5 ms.
+void pump(ControlServer& server, int rounds = 20) {
+  for (int round = 0; round < rounds; ++round) {
+    std::vector<pollfd> fds;
+    server.append_poll_fds(fds);
+    poll(fds.data(), fds.size(), 5);
+    server.service(fds);
+  }
+}
+
+// Reads what has arrived on a client socket (non-blocking).
+std::string drain(int fd) {
+  std::string text;
+  char buffer[4096];
+  for (;;) {
+    const ssize_t got = recv(fd, buffer, sizeof(buffer), MSG_DONTWAIT);
+    if (got <= 0) return text;
+    text.append(buffer, static_cast<std::size_t>(got));
+  }
+}
+
+TEST(ControlServer, AnswersPipelinedRequestsInOrderOneLineEach) {
+  // GIVEN a server with a stub handler and one connected client
+  TempDir dir;
+  StubHandler handler;
+  auto server = ControlServer::listen(dir / "control", std::ref(handler));
+  ASSERT_TRUE(server.ok()) << server.status().to_string();
+  const int client = connect_to(dir / "control");
+  ASSERT_GE(client, 0);
+  // WHEN it sends three requests in one write, the last split over two writes
+  send_text(client, "status\nshow\nhis");
+  pump(*server.value());
+  send_text(client, "tory\r\n");
+  pump(*server.value());
+  // THEN it gets three responses, in request order
+  EXPECT_EQ(drain(client), "{\"echo\":\"status\"}\n{\"echo\":\"show\"}\n{\"echo\":\"history\r\"}\n");
+  EXPECT_EQ(handler.calls, 3);
+  close(client);
+}
+
+TEST(ControlServer, ServesManyConcurrentClientsEachItsOwnAnswers) {
+  // GIVEN 20 clients connected at the same time
+  TempDir dir;
+  StubHandler handler;
+  auto server = ControlServer::listen(dir / "control", std::ref(handler));
+  ASSERT_TRUE(server.ok());
+  std::vector<int> clients;
+  for (int k = 0; k < 20; ++k) {
+    clients.push_back(connect_to(dir / "control"));
+    pump(*server.value(), 1);  // the listen backlog is short: accept as they come
+  }
+  // WHEN each sends two requests naming itself, interleaved with the others
+  for (int k = 0; k < 20; ++k) send_text(clients[k], "first " + std::to_string(k) + "\n");
+  pump(*server.value());
+  for (int k = 19; k >= 0; --k) send_text(clients[k], "second " + std::to_string(k) + "\n");
+  pump(*server.value());
+  // THEN each client gets exactly its own two answers, in order
+  EXPECT_EQ(server.value()->client_count(), 20u);
+  for (int k = 0; k < 20; ++k) {
+    EXPECT_EQ(drain(clients[k]), "{\"echo\":\"first " + std::to_string(k) + "\"}\n{\"echo\":\"second " +
+                                     std::to_string(k) + "\"}\n");
+    close(clients[k]);
+  }
+  // AND closed clients are forgotten
+  pump(*server.value());
+  EXPECT_EQ(server.value()->client_count(), 0u);
+}
+
+TEST(ControlServer, AnswersARequestSentJustBeforeTheClientHalfCloses) {
+  // GIVEN a client that sends one request and shuts down its sending side
+  TempDir dir;
+  StubHandler handler;
+  auto server = ControlServer::listen(dir / "control", std::ref(handler));
+  ASSERT_TRUE(server.ok());
+  const int client = connect_to(dir / "control");
+  send_text(client, "status\n");
+  shutdown(client, SHUT_WR);
+  // WHEN the server runs
+  pump(*server.value());
+  // THEN the answer still arrives and the connection is then closed
+  EXPECT_EQ(drain(client), "{\"echo\":\"status\"}\n");
+  EXPECT_EQ(server.value()->client_count(), 0u);
+  close(client);
+}
+
+TEST(ControlServer, RefusesAnOverlongRequestAndKeepsServingTheClient) {
+  // GIVEN a connected client
+  TempDir dir;
+  StubHandler handler;
+  auto server = ControlServer::listen(dir / "control", std::ref(handler));
+  ASSERT_TRUE(server.ok());
+  const int client = connect_to(dir / "control");
+  // WHEN it sends 10 kB without a newline, then a newline and a good request
+  send_text(client, std::string(10'000, 'x'));
+  pump(*server.value());
+  send_text(client, "\nstatus\n");
+  pump(*server.value());
+  // THEN it gets one error line for the long request, then the answer; the handler never saw the long line
+  const std::string answer = drain(client);
+  EXPECT_NE(answer.find("\"ok\":false"), std::string::npos) << answer;
+  EXPECT_NE(answer.find("longer than"), std::string::npos) << answer;
+  EXPECT_NE(answer.find("{\"echo\":\"status\"}\n"), std::string::npos) << answer;
+  EXPECT_EQ(handler.calls, 1);
+  close(client);
+}
+
+TEST(ControlServer, TurnsAwayClientsBeyondTheLimitWithAReason) {
+  // GIVEN the server full of clients
+  TempDir dir;
+  StubHandler handler;
+  auto server = ControlServer::listen(dir / "control", std::ref(handler));
+  ASSERT_TRUE(server.ok());
+  std::vector<int> clients;
+  for (std::size_t k = 0; k < ControlServer::kMaxClients; ++k) {
+    clients.push_back(connect_to(dir / "control"));
+    pump(*server.value(), 1);
+  }
+  // WHEN one more connects
+  const int extra = connect_to(dir / "control");
+  pump(*server.value());
+  // THEN it is told why and closed, and the others stay connected
+  EXPECT_NE(drain(extra).find("too many control clients"), std::string::npos);
+  EXPECT_EQ(server.value()->client_count(), ControlServer::kMaxClients);
+  EXPECT_EQ(server.value()->counters().refused, 1u);
+  close(extra);
+  for (const int fd : clients) close(fd);
+}
+
+TEST(ControlServer, SocketHasMode0660AndIsRemovedOnDestruction) {
+  // GIVEN a server
+  TempDir dir;
+  StubHandler handler;
+  const std::string path = dir / "control";
+  {
+    auto server = ControlServer::listen(path, std::ref(handler));
+    ASSERT_TRUE(server.ok());
+    // THEN its socket is group-accessible only
+    struct stat info {};
+    ASSERT_EQ(stat(path.c_str(), &info), 0);
+    EXPECT_TRUE(S_ISSOCK(info.st_mode));
+    EXPECT_EQ(info.st_mode & 0777, 0660u);
+  }
+  // WHEN it is destroyed THEN the path is gone
+  EXPECT_FALSE(std::filesystem::exists(path));
+}
+
+TEST(ControlServer, ReplacesAStaleSocketButNeverAnotherFile) {
+  // GIVEN a socket file left by a crashed daemon, and a regular file elsewhere
+  TempDir dir;
+  StubHandler handler;
+  {
+    const int stale = socket(AF_UNIX, SOCK_STREAM, 0);
+    sockaddr_un address{};
+    address.sun_family = AF_UNIX;
+    std::snprintf(address.sun_path, sizeof(address.sun_path), "%s", (dir / "stale").c_str());
+    ASSERT_EQ(bind(stale, reinterpret_cast<const sockaddr*>(&address), sizeof(address)), 0);
+    close(stale);
+  }
+  std::ofstream(dir / "precious") << "keep me";
+  // WHEN servers are started on both paths
+  auto on_stale = ControlServer::listen(dir / "stale", std::ref(handler));
+  auto on_file = ControlServer::listen(dir / "precious", std::ref(handler));
+  // THEN the stale socket is replaced and the regular file refused and kept
+  EXPECT_TRUE(on_stale.ok()) << on_stale.status().to_string();
+  ASSERT_FALSE(on_file.ok());
+  EXPECT_EQ(on_file.status().code(), hal::ErrorCode::kInvalidArgument);
+  std::ifstream kept(dir / "precious");
+  std::string text;
+  std::getline(kept, text);
+  EXPECT_EQ(text, "keep me");
+}
+
+}  // namespace
+}  // namespace cdpr::daemon
