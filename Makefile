@@ -14,7 +14,7 @@ DEB_PACKAGES := build-essential cmake pkg-config libeigen3-dev libsuitesparse-de
 # Ceres is used by the benchmark comparison only, never linked into the daemon.
 BENCH_PACKAGES := libceres-dev
 
-.PHONY: all deps bench-deps configure test demo bench install clean
+.PHONY: all deps bench-deps configure test sanitize demo bench install clean
 
 all: configure
 	cmake --build $(BUILD) -j $(JOBS)
@@ -32,6 +32,13 @@ configure: deps $(BUILD)/CMakeCache.txt
 
 test: all
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+# The whole test suite under AddressSanitizer and UndefinedBehaviorSanitizer.
+sanitize: deps
+	cmake -S . -B $(BUILD)-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCDPR_WERROR=ON -DCDPR_SANITIZE=ON
+	cmake --build $(BUILD)-asan -j $(JOBS)
+	cd $(BUILD)-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
+	  ctest --output-on-failure -j $(JOBS)
 
 demo: all
 	./tools/demo.sh $(BUILD)

@@ -56,8 +56,9 @@ std::optional<Eigen::Vector2d> start_force(const Robot& robot, const Anchors& an
 PoseStart start_pose(const Robot& robot, const Anchors& anchors, const Sample& sample, const CalibrationOptions& o) {
   constexpr double kYawStepRad = 0.25 * M_PI / 180.0;
   constexpr int kYawSteps = 120;  // up to +-30 degrees
-  // A start whose cable ends miss their attachments by less than this is
-  // taken as it is; otherwise the whole yaw range is searched for the best.
+  // Turns are tried outwards from the measured heading; the first start
+  // whose cable ends miss their attachments by less than this is taken,
+  // otherwise the best of the whole range.
   constexpr double kGoodEnoughHeightMissM = 0.5;
   PoseStart best;
   double best_cost = std::numeric_limits<double>::infinity();
@@ -83,7 +84,7 @@ PoseStart start_pose(const Robot& robot, const Anchors& anchors, const Sample& s
     best.world_T_platform = pose;
     best.reference_force = *force;
     for (int i = 0; i < kCableCount; ++i) best.lengths[i] = (*cables)[i].arc_length_m;
-    if (step == 0 && worst_miss < kGoodEnoughHeightMissM) break;
+    if (worst_miss < kGoodEnoughHeightMissM) break;  // the smallest turn that gives a good start
   }
   if (!best.usable) {
     // Neither guess leads to an equilibrium at any heading: search the
