@@ -1,0 +1,131 @@
+// calibctl: the operator's client of cdpr-calibd's control socket. Starts and
+// aborts a field calibration, shows its progress, the current calibration,
+// the stored versions, and rolls back to one of them.
+//
+// Exit status: 0 done; 1 the daemon refused the request (or, with
+// status --follow, the run failed); 2 no daemon, or a broken connection.
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <thread>
+
+#include <CLI/CLI.hpp>
+
+#include "calibctl/control_client.h"
+#include "calibctl/json_value.h"
+#include "calibctl/render.h"
+
+namespace {
+
+using cdpr::calibctl::ControlClient;
+using cdpr::calibctl::JsonValue;
+
+constexpr int kExitRefused = 1;
+constexpr int kExitNoDaemon = 2;
+
+struct Options {
+  std::string socket_path = "/run/cdpr-calib/control";
+  bool json = false;
+  bool follow = false;
+  int interval_ms = 500;
+  int seq = 0;
+};
+
+// Sends one request; prints the error and returns nullopt when it fails.
+// `raw` receives the response line as the daemon sent it.
+std::optional<JsonValue> ask(ControlClient& client, const std::string& request, int& exit_code, std::string& raw) {
+  std::string& response = raw;
+  std::string error;
+  if (!client.request(request, response, error)) {
+    std::fprintf(stderr, "calibctl: %s\n", error.c_str());
+    exit_code = kExitNoDaemon;
+    return std::nullopt;
+  }
+  auto value = JsonValue::parse(response, &error);
+  if (!value) {
+    std::fprintf(stderr, "calibctl: unreadable response (%s): %s\n", error.c_str(), response.c_str());
+    exit_code = kExitNoDaemon;
+    return std::nullopt;
+  }
+  if (!(*value)["ok"].boolean()) {
+    std::fprintf(stderr, "calibctl: %s: %s\n", request.c_str(), (*value)["error"].string().c_str());
+    exit_code = kExitRefused;
+    return std::nullopt;
+  }
+  return value;
+}
+
+// Polls status until the run is over; prints a line whenever it changes.
+int follow(ControlClient& client, const Options& options) {
+  std::string last;
+  int exit_code = 0;
+  for (;;) {
+    std::string raw;
+    const auto status = ask(client, "status", exit_code, raw);
+    if (!status) return exit_code;
+    const std::string line = options.json ? raw : cdpr::calibctl::render_progress(*status);
+    if (line != last) {
+      std::printf("%s\n", line.c_str());
+      std::fflush(stdout);
+      last = line;
+    }
+    if (!(*status)["running"].boolean()) {
+      if (!options.json) std::printf("%s", cdpr::calibctl::render_status(*status).c_str());
+      return (*status)["state"].string() == "failed" ? kExitRefused : 0;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(options.interval_ms));
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"calibctl: control the cable-robot self-calibration daemon (cdpr-calibd) through its control socket"};
+  Options options;
+  if (const char* env = std::getenv("CDPR_CALIB_SOCKET")) options.socket_path = env;
+  app.add_option("--socket", options.socket_path, "the daemon's control socket (env CDPR_CALIB_SOCKET)")
+      ->capture_default_str();
+  app.add_flag("--json", options.json, "print the daemon's JSON response instead of text");
+  app.require_subcommand(1);
+  auto* start = app.add_subcommand("start", "start a field calibration (as the button does)");
+  start->add_flag("--follow,-f", options.follow, "then show progress until the run ends");
+  app.add_subcommand("abort", "abort the calibration in progress (winches halted, old calibration kept)");
+  auto* status = app.add_subcommand("status", "state, waypoint k/N, progress and reasons");
+  status->add_flag("--follow,-f", options.follow, "show progress until the run ends (exit 1 if it fails)");
+  status->add_option("--interval", options.interval_ms, "poll interval of --follow [ms]")
+      ->check(CLI::Range(50, 60'000))->capture_default_str();
+  app.add_subcommand("show", "the current calibration");
+  app.add_subcommand("history", "the stored calibrations, newest first (* = current)");
+  auto* rollback = app.add_subcommand("rollback", "make stored calibration SEQ current again");
+  rollback->add_option("seq", options.seq, "sequence number (see history)")->required()->check(CLI::PositiveNumber);
+  CLI11_PARSE(app, argc, argv);
+
+  const std::string command = app.get_subcommands().front()->get_name();
+  ControlClient client;
+  std::string error;
+  if (!client.connect(options.socket_path, error)) {
+    std::fprintf(stderr, "calibctl: %s\n", error.c_str());
+    return kExitNoDaemon;
+  }
+  const std::string request = command == "rollback" ? "rollback " + std::to_string(options.seq) : command;
+  int exit_code = 0;
+  if (command == "status" && options.follow) return follow(client, options);
+  std::string raw;
+  const auto response = ask(client, request, exit_code, raw);
+  if (!response) return exit_code;
+  using namespace cdpr::calibctl;
+  if (options.json) {
+    std::printf("%s\n", raw.c_str());
+  } else if (command == "status") {
+    std::printf("%s", render_status(*response).c_str());
+  } else if (command == "show") {
+    std::printf("%s", render_show(*response).c_str());
+  } else if (command == "history") {
+    std::printf("%s", render_history(*response).c_str());
+  } else {
+    std::printf("%s\n", (*response)["message"].string().c_str());
+    if (command == "start" && options.follow) return follow(client, options);
+  }
+  return 0;
+}

@@ -1,0 +1,88 @@
+#include "calibctl/render.h"
+
+#include <cstdio>
+
+namespace cdpr::calibctl {
+namespace {
+
+template <class... Args>
+std::string format(const char* pattern, Args... args) {
+  char buffer[512];
+  std::snprintf(buffer, sizeof(buffer), pattern, args...);
+  return buffer;
+}
+
+void append_if(std::string& out, const char* label, const JsonValue& text) {
+  if (!text.string().empty()) out += format("  %s: %s\n", label, text.string().c_str());
+}
+
+double at(const JsonValue& vector, std::size_t k) {
+  return k < vector.array().size() ? vector.array()[k].number() : 0.0;
+}
+
+}  // namespace
+
+std::string render_status(const JsonValue& s) {
+  std::string out = format("%s", s["state"].string().c_str());
+  if (s["waypoints"].integer() > 0) {
+    out += format("  waypoint %d/%d  samples %d  skipped %d", s["waypoint"].integer(), s["waypoints"].integer(),
+                  s["samples"].integer(), s["skipped"].integer());
+  }
+  out += format("  %.0f%%", 100.0 * s["progress"].number());
+  if (!s["elapsed_s"].is_null()) out += format("  %.1f s", s["elapsed_s"].number());
+  out += "\n";
+  append_if(out, "detail", s["detail"]);
+  append_if(out, "note", s["note"]);
+  append_if(out, "reason", s["reason"]);
+  if (s["committed_seq"].integer() > 0) out += format("  committed: calibration %d\n", s["committed_seq"].integer());
+  return out;
+}
+
+std::string render_progress(const JsonValue& s) {
+  std::string out = format("[%3.0f%%] %-9s", 100.0 * s["progress"].number(), s["state"].string().c_str());
+  if (s["waypoints"].integer() > 0) {
+    out += format(" %2d/%d (%d sampled, %d skipped)", s["waypoint"].integer(), s["waypoints"].integer(),
+                  s["samples"].integer(), s["skipped"].integer());
+  }
+  if (!s["detail"].string().empty()) out += "  " + s["detail"].string();
+  return out;
+}
+
+std::string render_show(const JsonValue& s) {
+  if (!s["present"].boolean()) return "no calibration committed yet\n";
+  std::string out = format("calibration %d  created %s  robot %s  %d samples  model", s["seq"].integer(),
+                           s["created"].string().c_str(), s["robot"].string().c_str(), s["samples"].integer());
+  for (const JsonValue& term : s["model"].array()) out += " " + term.string();
+  out += "\n";
+  out += "cable  anchor x, y, z [m]                    sigma x, y, z [m]         offset [m]  sigma [m]\n";
+  int cable = 0;
+  for (const JsonValue& w : s["winches"].array()) {
+    const JsonValue& a = w["anchor"];
+    const JsonValue& sa = w["anchor_sigma"];
+    out += format("%5d  %11.4f %11.4f %11.4f    %7.4f %7.4f %7.4f    %10.4f  %9.4f\n", cable++, at(a, 0), at(a, 1),
+                  at(a, 2), at(sa, 0), at(sa, 1), at(sa, 2), w["offset"].number(), w["offset_sigma"].number());
+  }
+  const JsonValue& fit = s["fit"];
+  out += format("fit: cost %.4g -> %.4g in %d iterations, rms encoder %.4f m, rms force %.3f N\n",
+                fit["cost_initial"].number(), fit["cost_final"].number(), fit["iterations"].integer(),
+                fit["rms_encoder"].number(), fit["rms_force"].number());
+  return out;
+}
+
+std::string render_history(const JsonValue& s) {
+  const auto& entries = s["history"].array();
+  if (entries.empty()) return "no stored calibrations\n";
+  std::string out;
+  for (const JsonValue& e : entries) {
+    out += format("%c %6d  ", e["current"].boolean() ? '*' : ' ', e["seq"].integer());
+    if (e["valid"].boolean()) {
+      out += format("%s  robot %s  %d samples\n", e["created"].string().c_str(), e["robot"].string().c_str(),
+                    e["samples"].integer());
+    } else {
+      out += "unreadable: " + e["problem"].string() + "\n";
+    }
+  }
+  return out;
+}
+
+}  // namespace cdpr::calibctl

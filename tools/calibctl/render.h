@@ -1,0 +1,21 @@
+#pragma once
+// Human-readable text of the control socket's responses
+// (src/control/control_response.h) for calibctl. Pure functions.
+
+#include <string>
+
+#include "calibctl/json_value.h"
+
+namespace cdpr::calibctl {
+
+// "settle  waypoint 3/35  samples 2  skipped 0  12%  41.2 s" plus lines for
+// detail, note and reason when present.
+std::string render_status(const JsonValue& status);
+// One line for `status --follow`: "[ 12%] settle 3/35 (2 sampled, 0 skipped) platform moving: ...".
+std::string render_progress(const JsonValue& status);
+// The current calibration: one line per winch with anchor, offset and sigmas, then the fit.
+std::string render_show(const JsonValue& show);
+// The stored versions, newest first, the current one marked.
+std::string render_history(const JsonValue& history);
+
+}  // namespace cdpr::calibctl
