@@ -1,0 +1,67 @@
+// virtual-robot: a simulated cable robot speaking the real protocols (CAN
+// frames over a Unix socket, Modbus TCP, pose stream) with physics from the
+// simulator, for running cdpr-calibd without hardware (make demo, tests).
+// Runs until SIGTERM or SIGINT.
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+
+#include <CLI/CLI.hpp>
+
+#include "virtual-robot/virtual_robot.h"
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop.store(true); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using cdpr::virtual_robot::VirtualRobotOptions;
+  CLI::App app{"virtual-robot: a simulated cable robot (true heavy-cable equilibrium, first-order settling, "
+               "sensor noise of the preset) serving CANopen over a Unix socket, a Modbus TCP load cell and a "
+               "pose stream; writes robot.toml (nominal), truth.toml and 'ready' into --endpoints"};
+  VirtualRobotOptions options;
+  std::string preset = "large";
+  app.add_option("--preset", preset, "robot of the paper's Table I: large or small")
+      ->check(CLI::IsMember({"large", "small"}))->capture_default_str();
+  app.add_option("--seed", options.seed, "true encoder offsets, nominal anchor perturbation, sensor noise")
+      ->capture_default_str();
+  app.add_option("--time-scale", options.time_scale, "simulated seconds per real second (drive speed, settling)")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--endpoints,--dir", options.dir,
+                 "directory for can.sock, pose.sock, robot.toml, truth.toml and ready (created)")->required();
+  app.add_option("--modbus-port", options.modbus_port, "Modbus TCP port on 127.0.0.1; 0: any free port (see ready)")
+      ->check(CLI::Range(0, 65535))->capture_default_str();
+  app.add_option("--anchor-perturbation", options.anchor_perturbation_m,
+                 "robot.toml's nominal anchors = true anchors + a random vector of this norm [m]")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--noise-scale", options.noise_scale, "multiplies every sensor sigma of the preset; 0: noiseless")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--time-constant", options.physics.time_constant_s, "platform settling time constant [s, simulated]")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--winch-speed", options.physics.winch_speed_mps, "drive profile velocity [m/s, simulated]")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--pose-rate", options.pose_rate_hz, "pose stream rate [Hz, real time]")
+      ->check(CLI::Range(1.0, 1000.0))->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  options.preset = *cdpr::sim::parse_preset(preset);
+
+  std::error_code error;
+  std::filesystem::create_directories(options.dir, error);
+  auto robot = cdpr::virtual_robot::VirtualRobot::create(options);
+  if (!robot) {
+    std::fprintf(stderr, "virtual-robot: %s\n", robot.error().c_str());
+    return 1;
+  }
+  std::signal(SIGTERM, on_signal);
+  std::signal(SIGINT, on_signal);
+  std::printf("virtual-robot: %s preset, seed %llu, time x%g; CAN %s, load cell %s, pose %s\n", preset.c_str(),
+              static_cast<unsigned long long>(options.seed), options.time_scale, (*robot)->can_endpoint().c_str(),
+              (*robot)->modbus_endpoint().c_str(), (*robot)->pose_endpoint().c_str());
+  std::fflush(stdout);
+  (*robot)->run(g_stop);
+  std::printf("virtual-robot: stopped (%d equilibrium solves failed)\n", (*robot)->physics().failed_solves());
+  return 0;
+}

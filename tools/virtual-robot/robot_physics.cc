@@ -1,0 +1,59 @@
+#include "virtual-robot/robot_physics.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace cdpr::virtual_robot {
+
+Expected<RobotPhysics, std::string> RobotPhysics::at_rest(const sim::TrueRobot& robot,
+                                                           const Eigen::Vector3d& start_world,
+                                                           const PhysicsOptions& options) {
+  sim::SolverOptions solver;
+  solver.segments = options.segments;
+  const sim::EquilibriumResult rest = sim::solve_equilibrium(robot, start_world, 0.0, solver);
+  if (!rest) return Unexpected{"no rest pose at the start position: " + rest.error().message};
+  return RobotPhysics(robot, *rest, options);
+}
+
+RobotPhysics::RobotPhysics(const sim::TrueRobot& robot, const sim::Equilibrium& rest, const PhysicsOptions& options)
+    : robot_(robot), options_(options), rest_(rest), pose_(rest.world_T_platform) {
+  for (int i = 0; i < kCableCount; ++i) {
+    payout_m_[i] = rest.cables[i].payout_m + robot.encoder_offset_m[i];
+    target_m_[i] = payout_m_[i];
+    solved_payout_m_[i] = payout_m_[i];
+    tension_n_[i] = rest.cables[i].tension_n;
+  }
+}
+
+void RobotPhysics::advance(double dt_s) {
+  if (dt_s <= 0.0) return;
+  const double step_m = options_.winch_speed_mps * dt_s;
+  for (int i = 0; i < kCableCount; ++i) {
+    payout_m_[i] += std::clamp(target_m_[i] - payout_m_[i], -step_m, step_m);
+  }
+  since_solve_s_ += dt_s;
+  if (payout_m_ != solved_payout_m_ && since_solve_s_ >= options_.equilibrium_interval_s) solve_rest();
+
+  // First-order approach to the rest state: exact for any step length.
+  const double a = 1.0 - std::exp(-dt_s / options_.time_constant_s);
+  pose_.position_world += a * (rest_.world_T_platform.position_world - pose_.position_world);
+  pose_.world_R_platform = pose_.world_R_platform.slerp(a, rest_.world_T_platform.world_R_platform).normalized();
+  for (int i = 0; i < kCableCount; ++i) tension_n_[i] += a * (rest_.cables[i].tension_n - tension_n_[i]);
+}
+
+void RobotPhysics::solve_rest() {
+  since_solve_s_ = 0.0;
+  std::array<double, kCableCount> unstretched_m{};
+  for (int i = 0; i < kCableCount; ++i) unstretched_m[i] = payout_m_[i] - robot_.encoder_offset_m[i];
+  sim::SolverOptions solver;
+  solver.segments = options_.segments;
+  const sim::EquilibriumResult next = sim::solve_forward_equilibrium(robot_, unstretched_m, rest_.world_T_platform, solver);
+  if (!next) {
+    ++failed_solves_;
+    return;  // keep the last rest state; a later solve from the moved cables may succeed
+  }
+  rest_ = *next;
+  solved_payout_m_ = payout_m_;
+}
+
+}  // namespace cdpr::virtual_robot

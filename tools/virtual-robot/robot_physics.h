@@ -1,0 +1,77 @@
+#pragma once
+// The virtual robot's mechanics: four winches paying out cable at a profile
+// speed, and a platform that follows the TRUE static equilibrium of the
+// heavy cables (sim/equilibrium.h, solve_forward_equilibrium) with a
+// first-order lag, so it swings into place and settles like the real one.
+//
+// Units and conventions: payout [m] in encoder units, as the robot's
+// encoders count it: payout_i = unstretched cable from the anchor point to
+// the attachment + true encoder offset_i (FORMATS.md enc_i). The
+// equilibrium is recomputed whenever the cables have moved, at most every
+// equilibrium_interval_s of simulated time; between solves the platform
+// relaxes towards the latest equilibrium with time constant
+// time_constant_s (pose and cable tensions alike).
+// Time: simulated seconds passed to advance(); no clock read here.
+// Not thread-safe.
+
+#include <array>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "sim/equilibrium.h"
+#include "sim/true_robot.h"
+#include "solver/pose.h"
+#include "src/formats/expected.h"
+
+namespace cdpr::virtual_robot {
+
+struct PhysicsOptions {
+  double time_constant_s = 0.2;          // platform settling [s]
+  double winch_speed_mps = 2.0;          // profile velocity of every drive [m/s]
+  double equilibrium_interval_s = 0.05;  // least simulated time between equilibrium solves [s]
+  int segments = 200;                    // Simpson segments per cable (sim/cable_shooting.h)
+};
+
+class RobotPhysics {
+ public:
+  // The platform at rest at `start_world` with heading 0; fails when that
+  // pose has no taut equilibrium.
+  static Expected<RobotPhysics, std::string> at_rest(const sim::TrueRobot& robot, const Eigen::Vector3d& start_world,
+                                                     const PhysicsOptions& options);
+
+  // Drive i moves towards `payout_m` at the profile speed.
+  void set_target(int winch, double payout_m) { target_m_[winch] = payout_m; }
+  // Drive i stops where it is (halt, quick stop, power off).
+  void stop(int winch) { target_m_[winch] = payout_m_[winch]; }
+  void advance(double dt_s);
+
+  double payout_m(int winch) const { return payout_m_[winch]; }
+  bool at_target(int winch) const { return payout_m_[winch] == target_m_[winch]; }
+  const Pose& pose() const { return pose_; }
+  // Tension of cable i at its attachment [N] (what a load cell there reads).
+  double tension_n(int cable) const { return tension_n_[cable]; }
+  // Tension change still to come [N]: how far the cable is from its rest value.
+  double tension_unsettled_n(int cable) const { return std::abs(rest_.cables[cable].tension_n - tension_n_[cable]); }
+  // Equilibrium solves that failed (commanded lengths without a taut rest
+  // pose); the platform stays at the last equilibrium then.
+  int failed_solves() const { return failed_solves_; }
+  const sim::TrueRobot& robot() const { return robot_; }
+
+ private:
+  RobotPhysics(const sim::TrueRobot& robot, const sim::Equilibrium& rest, const PhysicsOptions& options);
+  void solve_rest();
+
+  sim::TrueRobot robot_;
+  PhysicsOptions options_;
+  sim::Equilibrium rest_;  // where the platform is heading
+  Pose pose_;
+  std::array<double, kCableCount> tension_n_{};
+  std::array<double, kCableCount> payout_m_{};
+  std::array<double, kCableCount> target_m_{};
+  std::array<double, kCableCount> solved_payout_m_{};  // payouts of rest_
+  double since_solve_s_ = 0.0;
+  int failed_solves_ = 0;
+};
+
+}  // namespace cdpr::virtual_robot

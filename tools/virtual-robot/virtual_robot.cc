@@ -1,0 +1,154 @@
+#include "virtual-robot/virtual_robot.h"
+
+#include <poll.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "drivers/can/fd_can_transport.h"
+#include "drivers/pose/pose_line.h"
+#include "sim/stream_purpose.h"
+#include "solver/pose.h"
+#include "src/formats/calibration_toml.h"
+#include "src/formats/robot_toml.h"
+
+namespace cdpr::virtual_robot {
+namespace {
+
+// A stream of its own for the live sensor noise (sim/stream_purpose.h uses 1-5).
+constexpr std::uint64_t kStreamLiveNoise = 101;
+
+bool write_file(const std::string& path, const std::string& text) {
+  std::ofstream file(path, std::ios::binary | std::ios::trunc);
+  file << text;
+  file.close();
+  return static_cast<bool>(file);
+}
+
+}  // namespace
+
+Expected<std::unique_ptr<VirtualRobot>, std::string> VirtualRobot::create(const VirtualRobotOptions& options) {
+  if (!(options.time_scale > 0.0)) return Unexpected{std::string("time scale must be > 0")};
+  // The simulator's own data-set builder gives the true robot (random true
+  // offsets) and the nominal robot.toml exactly as cdpr-sim would.
+  sim::DatasetConfig config;
+  config.preset = options.preset;
+  config.seed = options.seed;
+  config.pose_count = 1;
+  config.anchor_perturbation_m = options.anchor_perturbation_m;
+  config.noise_scale = options.noise_scale;
+  config.segments = options.physics.segments;
+  auto data = sim::simulate_dataset(config);
+  if (!data) return Unexpected{"simulated robot: " + data.error()};
+  auto robot = std::unique_ptr<VirtualRobot>(new VirtualRobot(options, std::move(*data)));
+
+  const sim::PresetSpec spec = sim::preset_spec(options.preset);
+  const Eigen::Vector3d start_world = 0.5 * (spec.workspace_min + spec.workspace_max);
+  auto physics = RobotPhysics::at_rest(robot->data_.true_robot, start_world, options.physics);
+  if (!physics) return Unexpected{physics.error()};
+  robot->physics_ = std::make_unique<RobotPhysics>(std::move(*physics));
+
+  NodeLayout nodes = options.nodes;
+  nodes.encoder_noise_m = options.noise_scale * robot->data_.true_robot.robot.noise.encoder_m;
+  const hal::TimeUs now_us = robot->clock_.now_us();
+  robot->nodes_ = std::make_unique<CanopenNodes>(nodes, *robot->physics_,
+                                                 sim::Rng::stream(options.seed, kStreamLiveNoise, 1), now_us);
+  robot->start_us_ = robot->last_us_ = robot->next_pose_us_ = now_us;
+
+  auto can = StreamListener::listen(options.dir + "/can.sock");
+  if (!can.ok()) return Unexpected{"CAN socket: " + can.status().to_string()};
+  robot->can_ = std::move(can.value());
+  auto pose = StreamListener::listen(options.dir + "/pose.sock");
+  if (!pose.ok()) return Unexpected{"pose socket: " + pose.status().to_string()};
+  robot->pose_ = std::move(pose.value());
+  auto modbus = ModbusServer::listen(options.modbus_port, options.modbus_slave_id,
+                                     drivers::modbus::WordOrder::kHighWordFirst);
+  if (!modbus.ok()) return Unexpected{"load cell: " + modbus.status().to_string()};
+  robot->modbus_ = std::move(modbus.value());
+  robot->publish(now_us);
+
+  if (!write_file(options.dir + "/robot.toml", formats::format_robot_toml(robot->data_.nominal)) ||
+      !write_file(options.dir + "/truth.toml", formats::format_truth_toml(robot->data_.truth)) ||
+      !write_file(options.dir + "/ready", "modbus_port = " + std::to_string(robot->modbus_->port()) + "\n")) {
+    return Unexpected{"cannot write robot.toml, truth.toml or ready in " + options.dir};
+  }
+  return robot;
+}
+
+VirtualRobot::VirtualRobot(const VirtualRobotOptions& options, sim::SimulatedDataset data)
+    : options_(options), data_(std::move(data)), noise_(sim::Rng::stream(options.seed, kStreamLiveNoise, 0)) {}
+
+void VirtualRobot::run(const std::atomic<bool>& stop) {
+  while (!stop.load()) run_once(2'000);
+}
+
+void VirtualRobot::run_once(hal::TimeUs max_wait_us) {
+  fds_.clear();
+  can_->append_poll_fds(fds_);
+  pose_->append_poll_fds(fds_);
+  modbus_->append_poll_fds(fds_);
+  const int ready = poll(fds_.data(), fds_.size(), static_cast<int>(max_wait_us / 1000));
+  if (ready > 0) {
+    can_->service(fds_, [this](int client, std::string_view bytes) { on_can_bytes(client, bytes); });
+    pose_->service(fds_, [](int, std::string_view) {});  // the pose stream is one-way
+    modbus_->service(fds_);
+  }
+  const hal::TimeUs now_us = clock_.now_us();
+  physics_->advance(options_.time_scale * 1e-6 * static_cast<double>(now_us - last_us_));
+  last_us_ = now_us;
+  publish(now_us);
+}
+
+void VirtualRobot::on_can_bytes(int client, std::string_view bytes) {
+  std::string& partial = can_partial_[client];
+  partial.append(bytes);
+  std::size_t used = 0;
+  for (; partial.size() - used >= drivers::can::kWireFrameBytes; used += drivers::can::kWireFrameBytes) {
+    drivers::can::CanFrame frame;
+    if (drivers::can::decode_wire_frame(reinterpret_cast<const std::uint8_t*>(partial.data() + used), frame)) {
+      nodes_->on_frame(frame);
+    }
+  }
+  partial.erase(0, used);
+}
+
+void VirtualRobot::publish(hal::TimeUs now_us) {
+  frames_.clear();
+  nodes_->poll(now_us, frames_);
+  std::uint8_t wire[drivers::can::kWireFrameBytes];
+  std::string bytes;
+  for (const drivers::can::CanFrame& frame : frames_) {
+    drivers::can::encode_wire_frame(frame, wire);
+    bytes.append(reinterpret_cast<const char*>(wire), sizeof(wire));
+  }
+  if (!bytes.empty()) can_->broadcast(bytes);
+
+  const Robot& robot = data_.true_robot.robot;
+  const double k = options_.noise_scale;
+  // Load cell: the cell calls its reading stable once it stops changing.
+  const int reference = robot.reference_cable;
+  bool winches_still = true;
+  for (int i = 0; i < kCableCount; ++i) winches_still = winches_still && physics_->at_target(i);
+  drivers::modbus::TensionRegisters cell;
+  cell.tension_n = static_cast<float>(physics_->tension_n(reference) + k * robot.noise.force_n * noise_.normal());
+  cell.stable = winches_still && physics_->tension_unsettled_n(reference) < std::max(1.0, robot.noise.force_n);
+  modbus_->set_value(cell);
+
+  if (now_us < next_pose_us_) return;
+  next_pose_us_ += static_cast<hal::TimeUs>(1e6 / options_.pose_rate_hz);
+  if (next_pose_us_ < now_us) next_pose_us_ = now_us;  // after a stall: no burst of old poses
+  const Pose& truth = physics_->pose();
+  const Eigen::Vector3d position =
+      truth.position_world + k * robot.noise.position_m * Eigen::Vector3d(noise_.normal(), noise_.normal(), noise_.normal());
+  const Eigen::Quaterniond rotation =
+      truth.world_R_platform *
+      so3_exp(k * robot.noise.orientation_rad * Eigen::Vector3d(noise_.normal(), noise_.normal(), noise_.normal()));
+  hal::PoseSample sample;
+  sample.platform_world = {position.x(), position.y(), position.z()};
+  sample.world_R_platform = {rotation.w(), rotation.x(), rotation.y(), rotation.z()};
+  sample.valid = true;
+  sample.source_time_us = start_us_ + static_cast<hal::TimeUs>(options_.time_scale * static_cast<double>(now_us - start_us_));
+  pose_->broadcast(drivers::pose::format_pose_line(sample));
+}
+
+}  // namespace cdpr::virtual_robot

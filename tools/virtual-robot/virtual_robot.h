@@ -1,0 +1,97 @@
+#pragma once
+// The virtual robot: a simulated cable robot that speaks the real robot's
+// protocols, so cdpr-calibd runs against it unchanged but for its endpoints
+// (DESIGN.md "Where this runs").
+//
+//   <dir>/can.sock    CAN frames over a Unix stream socket (the record format
+//                     of drivers/can/fd_can_transport.h): 4 CiA 402 drives and
+//                     4 CiA 406 encoders (canopen_nodes.h)
+//   127.0.0.1:<port>  Modbus TCP load cell on the reference cable
+//                     (drivers/modbus/tension_registers.h at address 0)
+//   <dir>/pose.sock   pose stream (drivers/pose/pose_line.h) at pose_rate_hz
+//   <dir>/robot.toml  the NOMINAL robot (anchors perturbed), for the daemon
+//   <dir>/truth.toml  the truth (anchors, encoder offsets), for comparison
+//   <dir>/ready       "modbus_port = <port>", written once everything listens
+//
+// Physics (robot_physics.h) from the simulator's true equilibrium; sensor
+// noise per the preset (robot.toml [noise]) on every single reading.
+// Time: simulated time runs time_scale times faster than the monotonic
+// clock (drive speeds, settling), while heartbeats, PDO and pose rates stay
+// in real time, as the daemon's timeouts are. Not thread-safe: one thread
+// calls run_once()/run().
+
+#include <atomic>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "drivers/clock/monotonic_clock.h"
+#include "sim/dataset.h"
+#include "sim/presets.h"
+#include "sim/rng.h"
+#include "src/formats/expected.h"
+#include "virtual-robot/canopen_nodes.h"
+#include "virtual-robot/modbus_server.h"
+#include "virtual-robot/robot_physics.h"
+#include "virtual-robot/stream_listener.h"
+
+namespace cdpr::virtual_robot {
+
+struct VirtualRobotOptions {
+  sim::Preset preset = sim::Preset::kLarge;
+  std::uint64_t seed = 1;
+  double time_scale = 1.0;            // simulated seconds per real second
+  double anchor_perturbation_m = 1.0; // nominal anchors of robot.toml = truth + this [m]
+  double noise_scale = 1.0;           // multiplies every sensor sigma
+  std::string dir;                    // sockets and files (must exist)
+  int modbus_port = 0;                // 0: any free port
+  int modbus_slave_id = 1;
+  double pose_rate_hz = 100.0;
+  PhysicsOptions physics;
+  NodeLayout nodes;                   // encoder noise is set from the preset
+};
+
+class VirtualRobot {
+ public:
+  static Expected<std::unique_ptr<VirtualRobot>, std::string> create(const VirtualRobotOptions& options);
+
+  // Serves the sockets for at most max_wait_us, then advances the physics to
+  // now and publishes what is due.
+  void run_once(hal::TimeUs max_wait_us);
+  // run_once() until `stop` becomes true.
+  void run(const std::atomic<bool>& stop);
+
+  std::string can_endpoint() const { return "unix:" + options_.dir + "/can.sock"; }
+  std::string pose_endpoint() const { return "unix:" + options_.dir + "/pose.sock"; }
+  std::string modbus_endpoint() const { return "tcp:127.0.0.1:" + std::to_string(modbus_->port()); }
+  const Robot& nominal_robot() const { return data_.nominal; }
+  const Truth& truth() const { return data_.truth; }
+  const RobotPhysics& physics() const { return *physics_; }
+  CanopenNodes& nodes() { return *nodes_; }
+  ModbusServer& load_cell() { return *modbus_; }
+
+ private:
+  VirtualRobot(const VirtualRobotOptions& options, sim::SimulatedDataset data);
+  void publish(hal::TimeUs now_us);
+  void on_can_bytes(int client, std::string_view bytes);
+
+  VirtualRobotOptions options_;
+  sim::SimulatedDataset data_;
+  drivers::MonotonicClock clock_;
+  sim::Rng noise_;
+  std::unique_ptr<RobotPhysics> physics_;
+  std::unique_ptr<CanopenNodes> nodes_;
+  std::unique_ptr<StreamListener> can_;
+  std::unique_ptr<StreamListener> pose_;
+  std::unique_ptr<ModbusServer> modbus_;
+  std::map<int, std::string> can_partial_;  // per CAN client: bytes of an incomplete record
+  hal::TimeUs last_us_ = 0;
+  hal::TimeUs start_us_ = 0;
+  hal::TimeUs next_pose_us_ = 0;
+  std::vector<drivers::can::CanFrame> frames_;
+  std::vector<pollfd> fds_;
+};
+
+}  // namespace cdpr::virtual_robot
