@@ -1,0 +1,88 @@
+#pragma once
+// cdpr-calibd's configuration file (/etc/cdpr-calib/cdpr-calibd.toml): the
+// keys, tables, defaults and units are exactly those documented in
+// systemd/cdpr-calibd.toml, the example that ships with the unit. Only
+// `robot` is required; every other key has the default shown there.
+//
+// Errors (STYLE.md, chrony conf.c): unknown keys, wrong types and values out
+// of range are refused at parse time with file, line and dotted key
+// ("cdpr-calibd.toml:40: winches.winch[2].drive_node_id: ..."). Never throws.
+//
+// Driver settings are plain values here (src/ does not see drivers/);
+// main() turns them into the drivers' own configurations.
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "hal/clock.h"
+#include "solver/calibrate.h"
+#include "src/calibration/calibration_state_machine.h"
+#include "src/formats/expected.h"
+#include "src/formats/format_error.h"
+#include "src/store/calibration_store.h"
+
+namespace cdpr::daemon {
+
+struct WinchNodes {
+  int drive_node_id = 1;              // CiA 402 drive, 1..127
+  int encoder_node_id = 11;           // CiA 406 encoder, 1..127; 0: use the drive's position
+  double encoder_m_per_count = 1e-5;  // payout per encoder count [m], sign = direction, != 0
+  double drive_m_per_count = 1e-5;    // payout per drive count [m], != 0
+};
+
+struct WinchesConfig {
+  std::string endpoint = "socketcan:can0";  // or "unix:<path>"
+  hal::TimeUs heartbeat_timeout_us = 500'000;
+  hal::TimeUs resend_interval_us = 100'000;
+  std::vector<WinchNodes> winches;  // in cable order; default: drives 1..4, encoders 11..14
+};
+
+struct LoadCellConfig {
+  std::string endpoint = "rtu:/dev/ttyUSB0";  // or "tcp:<host>:<port>"
+  int baud = 19200;
+  char parity = 'N';  // 'N', 'E', 'O'
+  int data_bits = 8;
+  int stop_bits = 1;
+  int slave_id = 1;
+  bool input_registers = false;  // register_kind = "input" (0x04) instead of "holding" (0x03)
+  int first_register = 0;
+  bool low_word_first = false;   // word_order = "low_word_first"
+  hal::TimeUs response_timeout_us = 200'000;
+  int retries = 2;
+};
+
+struct PoseConfig {
+  std::string endpoint = "tcp:127.0.0.1:5600";  // or "unix:<path>"
+  hal::TimeUs connect_timeout_us = 1'000'000;
+};
+
+struct ButtonConfig {
+  bool gpio = true;  // kind = "gpio"; false: kind = "none" (calibctl start only)
+  std::string chip = "gpiochip0";
+  int line = 17;
+  bool active_low = true;
+  hal::TimeUs debounce_us = 50'000;
+};
+
+struct DaemonConfig {
+  std::string robot_path;  // robot.toml
+  store::StoreOptions store{"/var/lib/cdpr-calib", 10};
+  std::string control_socket = "/run/cdpr-calib/control";
+  hal::TimeUs loop_period_us = 20'000;
+  WinchesConfig winches;
+  LoadCellConfig load_cell;
+  PoseConfig pose;
+  ButtonConfig button;
+  calibration::CalibratorOptions calibrator;  // [limits], [waypoints], [equilibrium], [validation]
+  CalibrationOptions solver;                  // [solver]
+};
+
+// A DaemonConfig with the defaults of systemd/cdpr-calibd.toml.
+DaemonConfig default_daemon_config();
+
+// `source` names the input in messages (usually its path).
+Expected<DaemonConfig, FormatError> parse_daemon_config(std::string_view text, const std::string& source);
+Expected<DaemonConfig, FormatError> read_daemon_config(const std::string& path);
+
+}  // namespace cdpr::daemon

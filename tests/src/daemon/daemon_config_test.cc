@@ -1,0 +1,110 @@
+// cdpr-calibd.toml: the shipped example parses to the documented defaults,
+// and bad input is refused naming file, line and key.
+
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "src/daemon/daemon_config.h"
+
+namespace cdpr::daemon {
+namespace {
+
+const std::string kExample = std::string(CDPR_SOURCE_DIR) + "/systemd/cdpr-calibd.toml";
+
+TEST(DaemonConfig, TheShippedExampleParsesToTheDefaults) {
+  // GIVEN the example configuration installed with the unit
+  // WHEN it is read
+  const auto config = read_daemon_config(kExample);
+  // THEN it parses, and every value it shows equals the built-in default
+  ASSERT_TRUE(config) << config.error().message();
+  const DaemonConfig defaults = default_daemon_config();
+  EXPECT_EQ(config->robot_path, "/etc/cdpr-calib/robot.toml");
+  EXPECT_EQ(config->store.state_dir, defaults.store.state_dir);
+  EXPECT_EQ(config->store.history_depth, defaults.store.history_depth);
+  EXPECT_EQ(config->control_socket, defaults.control_socket);
+  EXPECT_EQ(config->loop_period_us, defaults.loop_period_us);
+  ASSERT_EQ(config->winches.winches.size(), 4u);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(config->winches.winches[i].drive_node_id, defaults.winches.winches[i].drive_node_id);
+    EXPECT_EQ(config->winches.winches[i].encoder_node_id, defaults.winches.winches[i].encoder_node_id);
+    EXPECT_EQ(config->winches.winches[i].encoder_m_per_count, defaults.winches.winches[i].encoder_m_per_count);
+  }
+  EXPECT_EQ(config->winches.heartbeat_timeout_us, defaults.winches.heartbeat_timeout_us);
+  EXPECT_EQ(config->load_cell.endpoint, defaults.load_cell.endpoint);
+  EXPECT_EQ(config->load_cell.response_timeout_us, defaults.load_cell.response_timeout_us);
+  EXPECT_EQ(config->pose.endpoint, defaults.pose.endpoint);
+  EXPECT_EQ(config->button.gpio, defaults.button.gpio);
+  EXPECT_EQ(config->button.line, defaults.button.line);
+  const auto& p = config->calibrator.planner;
+  EXPECT_EQ(p.waypoint_count, defaults.calibrator.planner.waypoint_count);
+  EXPECT_EQ(p.margin_m, defaults.calibrator.planner.margin_m);
+  EXPECT_EQ(p.z_max_m, defaults.calibrator.planner.z_max_m);
+  EXPECT_EQ(p.max_tension_n, defaults.calibrator.planner.max_tension_n);
+  EXPECT_EQ(config->calibrator.settle_timeout_us, defaults.calibrator.settle_timeout_us);
+  EXPECT_EQ(config->calibrator.equilibrium.window_us, defaults.calibrator.equilibrium.window_us);
+  EXPECT_EQ(config->calibrator.validation.max_anchor_change_m, defaults.calibrator.validation.max_anchor_change_m);
+  EXPECT_EQ(config->solver.max_iterations, defaults.solver.max_iterations);
+}
+
+TEST(DaemonConfig, ReadsTheValuesGivenWithTheirUnits) {
+  // GIVEN a configuration for the virtual robot
+  const std::string text = R"(robot = "/tmp/robot.toml"
+[loop]
+period_ms = 10
+[winches]
+endpoint = "unix:/tmp/can.sock"
+[load_cell]
+endpoint = "tcp:127.0.0.1:1502"
+parity = "E"
+word_order = "low_word_first"
+[button]
+kind = "none"
+[equilibrium]
+window_s = 1.5
+[validation]
+accept_max_iterations = true
+)";
+  // WHEN parsed
+  const auto config = parse_daemon_config(text, "vr.toml");
+  // THEN the values are there in the daemon's units
+  ASSERT_TRUE(config) << config.error().message();
+  EXPECT_EQ(config->loop_period_us, 10'000);
+  EXPECT_EQ(config->winches.endpoint, "unix:/tmp/can.sock");
+  EXPECT_EQ(config->load_cell.parity, 'E');
+  EXPECT_TRUE(config->load_cell.low_word_first);
+  EXPECT_FALSE(config->button.gpio);
+  EXPECT_EQ(config->calibrator.equilibrium.window_us, 1'500'000);
+  EXPECT_TRUE(config->calibrator.validation.accept_max_iterations);
+}
+
+TEST(DaemonConfig, RefusesBadInputNamingLineAndKey) {
+  struct Case {
+    std::string text;
+    int line;
+    std::string field;
+  };
+  const Case cases[] = {
+      {"robot = \"r\"\n[loop]\nperiod_msec = 10\n", 3, "loop.period_msec"},               // unknown key
+      {"robot = \"r\"\n[load_cell]\nslave_id = 300\n", 3, "load_cell.slave_id"},          // out of range
+      {"robot = \"r\"\n[button]\nkind = \"gpoi\"\n", 3, "button.kind"},                    // not a choice
+      {"robot = \"r\"\n[loop]\nperiod_ms = -5\n", 3, "loop.period_ms"},                    // not positive
+      {"robot = \"r\"\n[button]\nactive_low = 1\n", 3, "button.active_low"},               // not a bool
+      {"[store]\nstate_dir = \"/x\"\n", 0, "robot"},                                        // missing required
+      {"robot = \"r\"\n[[winches.winch]]\ndrive_node_id = 1\n", 2, "winches.winch"},       // not 4 winches
+  };
+  for (const Case& c : cases) {
+    // GIVEN a configuration with one mistake WHEN parsed
+    const auto config = parse_daemon_config(c.text, "bad.toml");
+    // THEN it is refused, naming the key (and its line where there is one)
+    ASSERT_FALSE(config) << c.text;
+    EXPECT_EQ(config.error().field, c.field) << config.error().message();
+    if (c.line > 0) {
+      EXPECT_EQ(config.error().line, c.line) << config.error().message();
+    }
+    EXPECT_EQ(config.error().file, "bad.toml");
+  }
+}
+
+}  // namespace
+}  // namespace cdpr::daemon
