@@ -4,6 +4,34 @@
 #include <cmath>
 
 namespace cdpr::virtual_robot {
+namespace {
+
+// Where the platform would hang if the cables were straight chords of
+// (1 - shrink) times the given lengths (orientation kept): Gauss-Newton on
+// |A_i - (p + R b_i)| = (1 - shrink) L_i. The forward equilibrium
+// (sim/equilibrium.h) starts by hanging each cable between its pulley and
+// the attachment at the initial pose, which needs every cable longer than
+// its chord there; a chord shorter by a sag-sized fraction gives such a
+// start close to the solution, even after a long move.
+Pose straight_cable_pose(const sim::TrueRobot& robot, const std::array<double, kCableCount>& length_m, double shrink,
+                         Pose pose) {
+  for (int iteration = 0; iteration < 20; ++iteration) {
+    Eigen::Matrix<double, kCableCount, 3> jacobian;
+    Eigen::Matrix<double, kCableCount, 1> residual;
+    for (int i = 0; i < kCableCount; ++i) {
+      const Eigen::Vector3d chord =
+          pose.transform(robot.robot.winches[i].attachment_platform) - robot.robot.winches[i].anchor_world;
+      residual(i) = chord.norm() - (1.0 - shrink) * length_m[i];
+      jacobian.row(i) = chord.normalized().transpose();
+    }
+    const Eigen::Vector3d step = jacobian.colPivHouseholderQr().solve(-residual);
+    pose.position_world += step;
+    if (step.norm() < 1e-9) break;
+  }
+  return pose;
+}
+
+}  // namespace
 
 Expected<RobotPhysics, std::string> RobotPhysics::at_rest(const sim::TrueRobot& robot,
                                                            const Eigen::Vector3d& start_world,
@@ -47,7 +75,14 @@ void RobotPhysics::solve_rest() {
   for (int i = 0; i < kCableCount; ++i) unstretched_m[i] = payout_m_[i] - robot_.encoder_offset_m[i];
   sim::SolverOptions solver;
   solver.segments = options_.segments;
-  const sim::EquilibriumResult next = sim::solve_forward_equilibrium(robot_, unstretched_m, rest_.world_T_platform, solver);
+  sim::EquilibriumResult next = sim::solve_forward_equilibrium(robot_, unstretched_m, rest_.world_T_platform, solver);
+  // Hauling cable in leaves some cables shorter than their chords at the old
+  // rest pose; start from straight-cable poses then (tighter chords first).
+  for (const double shrink : {1e-3, 3e-3, 1e-2}) {
+    if (next) break;
+    const Pose guess = straight_cable_pose(robot_, unstretched_m, shrink, rest_.world_T_platform);
+    next = sim::solve_forward_equilibrium(robot_, unstretched_m, guess, solver);
+  }
   if (!next) {
     ++failed_solves_;
     return;  // keep the last rest state; a later solve from the moved cables may succeed

@@ -1,0 +1,63 @@
+// The virtual robot's mechanics: winches move at their profile speed and the
+// platform settles into the true equilibrium of the new cable lengths.
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "sim/equilibrium.h"
+#include "sim/presets.h"
+#include "virtual-robot/robot_physics.h"
+
+namespace cdpr::virtual_robot {
+namespace {
+
+TEST(RobotPhysics, PlatformSettlesIntoTheEquilibriumOfTheCommandedPayouts) {
+  // GIVEN the large robot at rest in the middle of its workspace, offsets nonzero
+  sim::TrueRobot robot = sim::preset_spec(sim::Preset::kLarge).robot;
+  robot.encoder_offset_m = {1.0, -2.0, 0.5, 3.0};
+  const Eigen::Vector3d start(120.0, 110.0, 17.0);
+  auto physics = RobotPhysics::at_rest(robot, start, PhysicsOptions{});
+  ASSERT_TRUE(physics) << physics.error();
+  EXPECT_LT((physics->pose().position_world - start).norm(), 1e-6);
+  // WHEN cable 0 is paid out by 2 m and cable 2 hauled in by 2 m, and 20 s pass
+  const double p0 = physics->payout_m(0), p2 = physics->payout_m(2);
+  physics->set_target(0, p0 + 2.0);
+  physics->set_target(2, p2 - 2.0);
+  for (int k = 0; k < 2000; ++k) physics->advance(0.01);
+  // THEN the winches are there, and the platform rests where the true equilibrium of those payouts is
+  EXPECT_TRUE(physics->at_target(0) && physics->at_target(2));
+  EXPECT_EQ(physics->failed_solves(), 0);
+  std::array<double, kCableCount> unstretched{};
+  for (int i = 0; i < kCableCount; ++i) unstretched[i] = physics->payout_m(i) - robot.encoder_offset_m[i];
+  sim::SolverOptions options;
+  options.segments = PhysicsOptions{}.segments;
+  const auto expected = sim::solve_forward_equilibrium(robot, unstretched, physics->pose(), options);
+  ASSERT_TRUE(expected);
+  EXPECT_GT((physics->pose().position_world - start).norm(), 0.5);  // it did move
+  EXPECT_LT((physics->pose().position_world - expected->world_T_platform.position_world).norm(), 1e-6);
+  EXPECT_NEAR(physics->tension_n(0), expected->cables[0].tension_n, 1e-3);
+}
+
+}  // namespace
+}  // namespace cdpr::virtual_robot
+
+namespace cdpr::virtual_robot {
+namespace {
+
+TEST(RobotPhysics, FindsTheNewRestPoseAfterAMoveThroughSlackCables) {
+  // GIVEN the large robot at rest in the middle, and the payouts of a rest pose 60 m away
+  const sim::TrueRobot robot = sim::preset_spec(sim::Preset::kLarge).robot;
+  auto physics = RobotPhysics::at_rest(robot, Eigen::Vector3d(120.0, 110.0, 17.0), PhysicsOptions{});
+  ASSERT_TRUE(physics);
+  const auto goal = sim::solve_equilibrium(robot, Eigen::Vector3d(60.0, 80.0, 30.0), 0.0);
+  ASSERT_TRUE(goal);
+  // WHEN every winch runs there at the same speed (so cables go slack on the way) and time passes
+  for (int i = 0; i < kCableCount; ++i) physics->set_target(i, goal->cables[i].payout_m);
+  for (int k = 0; k < 10000; ++k) physics->advance(0.01);
+  // THEN the platform rests at that pose
+  EXPECT_LT((physics->pose().position_world - goal->world_T_platform.position_world).norm(), 1e-4);
+}
+
+}  // namespace
+}  // namespace cdpr::virtual_robot
