@@ -1,0 +1,179 @@
+#include "src/daemon/daemon_loop.h"
+
+#include <poll.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <vector>
+
+#include "src/control/control_dispatch.h"
+
+namespace cdpr::daemon {
+
+std::string utc_now_rfc3339() {
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[32];
+  std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return text;
+}
+
+DaemonLoop::DaemonLoop(const DaemonConfig& config, const Robot& robot, DaemonDevices devices,
+                       store::CalibrationStore& store, const hal::Clock& clock, ServiceNotifier& notifier,
+                       std::function<void(const std::string&)> log)
+    : config_(config), robot_(robot), devices_(devices), store_(store), clock_(clock), notifier_(notifier),
+      log_(std::move(log)) {
+  // No SolveFunction: the loop runs the fit on a worker thread (manage_solve).
+  machine_ = std::make_unique<calibration::CalibrationStateMachine>(
+      robot_,
+      calibration::CalibratorDevices{devices_.winches, devices_.load_cell, devices_.pose, devices_.button, store_},
+      config_.calibrator, calibration::SolveFunction{}, utc_now_rfc3339);
+}
+
+DaemonLoop::~DaemonLoop() { shutdown(); }
+
+hal::Status DaemonLoop::start() {
+  auto server = ControlServer::listen(config_.control_socket,
+                                      [this](std::string_view line) { return handle_request(line); });
+  if (!server.ok()) return server.status();
+  server_ = std::move(server.value());
+  const hal::TimeUs now_us = clock_.now_us();
+  service_idle_devices(now_us);
+  next_step_us_ = now_us;
+  notifier_.ready();
+  report(now_us);
+  return hal::Status::Ok();
+}
+
+std::string DaemonLoop::handle_request(std::string_view line) {
+  return control::respond(line, *machine_, store_, clock_.now_us());
+}
+
+void DaemonLoop::run(const std::atomic<bool>& stop) {
+  while (!stop.load()) run_once();
+  shutdown();
+}
+
+void DaemonLoop::run_once() {
+  // Serve the control socket until the next step is due.
+  std::vector<pollfd> fds;
+  for (;;) {
+    const hal::TimeUs left_us = next_step_us_ - clock_.now_us();
+    if (left_us <= 0) break;
+    fds.clear();
+    server_->append_poll_fds(fds);
+    const int ready = poll(fds.data(), fds.size(), static_cast<int>((left_us + 999) / 1000));
+    if (ready < 0 && errno == EINTR) return;  // a signal: let run() look at its flag
+    if (ready > 0) server_->service(fds);
+  }
+  const hal::TimeUs now_us = clock_.now_us();
+  // Fixed rate without drift; after a stall (a slow bus call) skip ahead.
+  next_step_us_ += config_.loop_period_us;
+  if (next_step_us_ < now_us) next_step_us_ = now_us + config_.loop_period_us;
+  step(now_us);
+}
+
+void DaemonLoop::step(hal::TimeUs now_us) {
+  if (!machine_->owns_hardware()) service_idle_devices(now_us);
+  machine_->step(now_us);
+  manage_solve(now_us);
+  report(now_us);
+  notifier_.watchdog();
+}
+
+void DaemonLoop::service_idle_devices(hal::TimeUs now_us) {
+  if (now_us >= next_reconnect_us_) {
+    next_reconnect_us_ = now_us + kReconnectIntervalUs;
+    // Logged when the outcome changes, not every round.
+    const auto reopen = [&](bool& open, std::string& last_error, const char* name, auto&& open_device) {
+      if (open) return;
+      const hal::Status status = open_device();
+      open = status.ok();
+      if (open) {
+        last_error.clear();
+        if (log_) log_(std::string(name) + " connected");
+      } else if (status.to_string() != last_error) {
+        last_error = status.to_string();
+        if (log_) log_(std::string(name) + " not available (retrying): " + last_error);
+      }
+    };
+    reopen(winches_open_, winches_error_, "winches", [&] { return devices_.winches.open(); });
+    reopen(load_cell_open_, load_cell_error_, "load cell", [&] { return devices_.load_cell.open(); });
+    reopen(pose_open_, pose_error_, "pose stream", [&] { return devices_.pose.open(); });
+  }
+  // Keep the bus and the pose stream drained so a start sees fresh data; a
+  // lost connection is reopened above on the next reconnect round.
+  if (winches_open_) {
+    const hal::Status status = devices_.winches.update(now_us);
+    if (status.code() == hal::ErrorCode::kNotConnected) {
+      devices_.winches.close();
+      winches_open_ = false;
+    }
+  }
+  if (pose_open_) {
+    const hal::Status status = devices_.pose.update(0);
+    if (status.code() == hal::ErrorCode::kNotConnected) {
+      devices_.pose.close();
+      pose_open_ = false;
+    }
+  }
+}
+
+void DaemonLoop::manage_solve(hal::TimeUs now_us) {
+  if (solving_) {
+    if (solve_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+    solving_ = false;
+    machine_->deliver_solve_result(solve_.get(), now_us);
+    return;
+  }
+  if (!machine_->solve_pending()) return;
+  if (log_) log_("solving with " + std::to_string(machine_->samples().size()) + " samples");
+  solving_ = true;
+  // Copies: the worker must not share anything with the loop thread.
+  solve_ = std::async(std::launch::async, [robot = robot_, samples = machine_->samples(), options = config_.solver] {
+    return calibrate(robot, samples, options);
+  });
+}
+
+void DaemonLoop::report(hal::TimeUs /*now_us*/) {
+  const calibration::CalibrationStatus& s = machine_->status();
+  std::string text = calibration::to_string(s.state);
+  if (s.waypoint_count > 0 && calibration::is_running(s.state)) {
+    text += " " + std::to_string(s.waypoint) + "/" + std::to_string(s.waypoint_count);
+  }
+  text += " (" + std::to_string(static_cast<int>(std::lround(100.0 * s.progress))) + "%)";
+  if (!s.reason.empty() && !calibration::is_running(s.state)) text += ": " + s.reason;
+  if (text == last_report_) return;
+  last_report_ = text;
+  notifier_.status(text);
+  if (log_) log_(text);
+}
+
+void DaemonLoop::shutdown() {
+  if (shut_down_) return;
+  shut_down_ = true;
+  notifier_.stopping();
+  const hal::TimeUs now_us = clock_.now_us();
+  if (calibration::is_running(machine_->status().state)) {
+    machine_->request_abort(now_us, "daemon stopping");
+    machine_->step(now_us);
+  }
+  if (winches_open_) {
+    // Stop every winch whatever the machine did: the daemon will not watch them any more.
+    const hal::Status stopped = devices_.winches.quick_stop();
+    if (!stopped.ok() && log_) log_("quick stop failed: " + stopped.to_string());
+    (void)devices_.winches.update(clock_.now_us());
+  }
+  if (solving_) solve_.wait();  // a fit in progress finishes; its result is dropped
+  devices_.winches.close();
+  devices_.load_cell.close();
+  devices_.pose.close();
+  winches_open_ = load_cell_open_ = pose_open_ = false;
+  server_.reset();
+  if (log_) log_("stopped: winches quick-stopped, devices closed");
+}
+
+}  // namespace cdpr::daemon

@@ -1,0 +1,114 @@
+#pragma once
+// cdpr-calibd's event loop: the OS wiring around the pure state machine
+// (STYLE.md: logic apart from the module wrapper, as PX4's
+// mc_att_control beside its module).
+//
+// Every period (config [loop] period_ms) it
+//   - serves the control socket in between (poll() with the time left to
+//     the next step as timeout, so a request is answered at once),
+//   - steps the CalibrationStateMachine with monotonic time (hal::Clock),
+//   - runs the solve on a worker thread when the machine asks for it, so
+//     the loop, the socket and the watchdog stay alive during a long fit,
+//   - when the machine does not own the devices: keeps the CAN bus and the
+//     pose stream drained and reconnects devices that are not open (every
+//     kReconnectIntervalUs), so a start finds fresh data,
+//   - reports READY, STATUS and WATCHDOG through the ServiceNotifier.
+// shutdown() stops the winches (abort a run: halt; then quick stop) and
+// closes the devices; the owner calls it on SIGTERM and exits 0.
+//
+// Ownership: devices, store and clock are the owner's and must outlive the
+// loop; the loop opens and closes the devices. Not thread-safe apart from
+// the internal solve thread; one thread calls everything.
+
+#include <atomic>
+#include <functional>
+#include <future>
+#include <memory>
+#include <string>
+
+#include "hal/button.h"
+#include "hal/clock.h"
+#include "hal/load_cell.h"
+#include "hal/pose_source.h"
+#include "hal/winch_bank.h"
+#include "solver/robot.h"
+#include "src/calibration/calibration_state_machine.h"
+#include "src/daemon/control_server.h"
+#include "src/daemon/daemon_config.h"
+#include "src/store/calibration_store.h"
+
+namespace cdpr::daemon {
+
+// The service manager (systemd's sd_notify in main(); a no-op or a recorder
+// in tests). Calls come from the loop thread.
+class ServiceNotifier {
+ public:
+  virtual ~ServiceNotifier() = default;
+  virtual void ready() = 0;
+  virtual void status(const std::string& text) = 0;
+  // Called every step; the implementation decides how often to really ping.
+  virtual void watchdog() = 0;
+  virtual void stopping() = 0;
+};
+
+struct DaemonDevices {
+  hal::WinchBank& winches;
+  hal::LoadCell& load_cell;
+  hal::PoseSource& pose;
+  hal::Button* button = nullptr;  // null: start only from the control socket
+};
+
+class DaemonLoop {
+ public:
+  static constexpr hal::TimeUs kReconnectIntervalUs = 2'000'000;
+
+  // `log` receives one line per event (state changes, device errors); may be empty.
+  DaemonLoop(const DaemonConfig& config, const Robot& robot, DaemonDevices devices, store::CalibrationStore& store,
+             const hal::Clock& clock, ServiceNotifier& notifier, std::function<void(const std::string&)> log);
+  ~DaemonLoop();
+
+  // Opens the control socket and (best effort: failures are logged and
+  // retried) the devices, then notifies READY. Errors: the control socket
+  // could not be created (the daemon cannot be controlled: exit non-zero).
+  hal::Status start();
+  // One iteration: serve the socket until the next step is due, then step.
+  void run_once();
+  // run_once() until `stop` is set (by a signal handler), then shutdown().
+  void run(const std::atomic<bool>& stop);
+  // Stops the winches and closes everything (idempotent).
+  void shutdown();
+
+  const calibration::CalibrationStateMachine& machine() const { return *machine_; }
+
+ private:
+  void step(hal::TimeUs now_us);
+  void service_idle_devices(hal::TimeUs now_us);
+  void manage_solve(hal::TimeUs now_us);
+  void report(hal::TimeUs now_us);
+  std::string handle_request(std::string_view line);
+
+  DaemonConfig config_;
+  Robot robot_;
+  DaemonDevices devices_;
+  store::CalibrationStore& store_;
+  const hal::Clock& clock_;
+  ServiceNotifier& notifier_;
+  std::function<void(const std::string&)> log_;
+  std::unique_ptr<calibration::CalibrationStateMachine> machine_;
+  std::unique_ptr<ControlServer> server_;
+  std::future<CalibrationResult> solve_;
+  bool solving_ = false;
+
+  bool winches_open_ = false, load_cell_open_ = false, pose_open_ = false;
+  std::string winches_error_, load_cell_error_, pose_error_;  // last logged open failure
+  hal::TimeUs next_reconnect_us_ = 0;
+  hal::TimeUs next_step_us_ = 0;
+  bool shut_down_ = false;
+  std::string last_report_;
+};
+
+// RFC 3339 UTC time of the wall clock ("2026-11-22T10:15:00Z") for the
+// `created` key of calibration.toml.
+std::string utc_now_rfc3339();
+
+}  // namespace cdpr::daemon

@@ -1,0 +1,167 @@
+// cdpr-calibd: the field self-calibration daemon of a cable robot
+// (DESIGN.md). main() alone chooses the drivers for the hal interfaces
+// from the configuration, then hands everything to the event loop
+// (src/daemon/daemon_loop.h).
+//
+// Runs under systemd (Type=notify: READY, STATUS, WATCHDOG via libsystemd)
+// or in the foreground (without NOTIFY_SOCKET the notifications are no-ops).
+// SIGTERM or SIGINT: the winches are stopped and the daemon exits 0.
+// Startup failures (bad configuration, robot.toml, state directory, control
+// socket) exit 1 so systemd can restart it; a device that is not there yet
+// is not a startup failure (the loop reconnects, and preflight refuses to
+// calibrate without it).
+#include <systemd/sd-daemon.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "drivers/can/canopen_winch_bank.h"
+#include "drivers/clock/monotonic_clock.h"
+#include "drivers/modbus/modbus_load_cell.h"
+#include "drivers/pose/pose_stream_source.h"
+#ifdef CDPR_HAVE_GPIOD
+#include "drivers/button/gpio_button.h"
+#endif
+#include "src/daemon/daemon_config.h"
+#include "src/daemon/daemon_loop.h"
+#include "src/formats/robot_toml.h"
+
+namespace {
+
+using namespace cdpr;
+
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop.store(true); }
+
+void log_line(const std::string& text) {
+  std::fprintf(stderr, "cdpr-calibd: %s\n", text.c_str());
+  std::fflush(stderr);
+}
+
+// sd_notify(3). Pings the watchdog at half its interval, as sd_watchdog_enabled(3) advises.
+class SdNotifier final : public daemon::ServiceNotifier {
+ public:
+  explicit SdNotifier(const hal::Clock& clock) : clock_(clock) {
+    std::uint64_t interval_us = 0;
+    if (sd_watchdog_enabled(0, &interval_us) > 0) ping_interval_us_ = static_cast<hal::TimeUs>(interval_us / 2);
+  }
+  void ready() override { sd_notify(0, "READY=1"); }
+  void status(const std::string& text) override { sd_notify(0, ("STATUS=" + text).c_str()); }
+  void watchdog() override {
+    if (ping_interval_us_ <= 0) return;
+    const hal::TimeUs now_us = clock_.now_us();
+    if (now_us - last_ping_us_ < ping_interval_us_) return;
+    last_ping_us_ = now_us;
+    sd_notify(0, "WATCHDOG=1");
+  }
+  void stopping() override { sd_notify(0, "STOPPING=1"); }
+
+ private:
+  const hal::Clock& clock_;
+  hal::TimeUs ping_interval_us_ = 0;  // 0: no watchdog configured
+  hal::TimeUs last_ping_us_ = 0;
+};
+
+drivers::can::CanWinchBankConfig winch_bank_config(const daemon::WinchesConfig& c) {
+  drivers::can::CanWinchBankConfig out;
+  out.heartbeat_timeout_us = c.heartbeat_timeout_us;
+  out.resend_interval_us = c.resend_interval_us;
+  for (const daemon::WinchNodes& w : c.winches) {
+    out.winches.push_back({w.drive_node_id, w.encoder_node_id, w.encoder_m_per_count, w.drive_m_per_count});
+  }
+  return out;
+}
+
+drivers::modbus::ModbusLoadCellConfig load_cell_config(const daemon::LoadCellConfig& c) {
+  drivers::modbus::ModbusLoadCellConfig out;
+  out.endpoint = c.endpoint;
+  out.baud = c.baud;
+  out.parity = c.parity;
+  out.data_bits = c.data_bits;
+  out.stop_bits = c.stop_bits;
+  out.slave_id = c.slave_id;
+  out.register_kind = c.input_registers ? drivers::modbus::RegisterKind::kInput : drivers::modbus::RegisterKind::kHolding;
+  out.first_register = c.first_register;
+  out.word_order = c.low_word_first ? drivers::modbus::WordOrder::kLowWordFirst : drivers::modbus::WordOrder::kHighWordFirst;
+  out.response_timeout_us = c.response_timeout_us;
+  out.retries = c.retries;
+  return out;
+}
+
+std::unique_ptr<hal::Button> open_button(const daemon::ButtonConfig& c) {
+  if (!c.gpio) return nullptr;
+#ifdef CDPR_HAVE_GPIOD
+  auto button = drivers::button::GpioButton::open({c.chip, static_cast<unsigned>(c.line), c.active_low, c.debounce_us});
+  if (!button.ok()) {
+    log_line("button: " + button.status().to_string() + "; starting only from the control socket");
+    return nullptr;
+  }
+  return std::move(button.value());
+#else
+  log_line("button: built without libgpiod; starting only from the control socket");
+  return nullptr;
+#endif
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"cdpr-calibd: field self-calibration daemon of a cable-driven parallel robot"};
+  std::string config_path = "/etc/cdpr-calib/cdpr-calibd.toml";
+  app.add_option("--config,-c", config_path, "configuration file (keys: see the example cdpr-calibd.toml)")
+      ->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+
+  const auto config = daemon::read_daemon_config(config_path);
+  if (!config) {
+    log_line("configuration: " + config.error().message());
+    return 1;
+  }
+  const auto robot = formats::read_robot_toml(config->robot_path);
+  if (!robot) {
+    log_line("robot: " + robot.error().message());
+    return 1;
+  }
+  const drivers::can::CanWinchBankConfig winch_config = winch_bank_config(config->winches);
+  const drivers::modbus::ModbusLoadCellConfig cell_config = load_cell_config(config->load_cell);
+  for (const std::string& problem : {drivers::can::validate(winch_config), drivers::modbus::validate(cell_config)}) {
+    if (!problem.empty()) {
+      log_line("configuration " + config_path + ": " + problem);
+      return 1;
+    }
+  }
+
+  store::CalibrationStore store(config->store);
+  if (const auto opened = store.open(); !opened) {
+    log_line("store: " + opened.error().message());
+    return 1;
+  }
+
+  drivers::MonotonicClock clock;
+  drivers::can::CanopenWinchBank winches(winch_config, drivers::can::make_can_connector(config->winches.endpoint));
+  drivers::modbus::ModbusLoadCell load_cell(cell_config, clock);
+  drivers::pose::PoseStreamSource pose(config->pose.endpoint, clock, config->pose.connect_timeout_us);
+  const std::unique_ptr<hal::Button> button = open_button(config->button);
+
+  struct sigaction action {};
+  action.sa_handler = on_signal;  // no SA_RESTART: poll() returns EINTR at once
+  sigaction(SIGTERM, &action, nullptr);
+  sigaction(SIGINT, &action, nullptr);
+  std::signal(SIGPIPE, SIG_IGN);
+
+  SdNotifier notifier(clock);
+  daemon::DaemonLoop loop(*config, *robot, {winches, load_cell, pose, button.get()}, store, clock, notifier, log_line);
+  if (const hal::Status started = loop.start(); !started.ok()) {
+    log_line(started.to_string());
+    return 1;
+  }
+  log_line("ready: robot " + robot->name + ", control socket " + config->control_socket + ", state " +
+           config->store.state_dir);
+  loop.run(g_stop);
+  return 0;
+}

@@ -1,0 +1,57 @@
+// The acceptance test of issue 5: the daemon with its real drivers calibrates
+// the virtual robot (large preset, 35 waypoints) over real sockets, started
+// and followed through the control socket; the committed anchors must lie
+// within 0.10 m of the virtual robot's truth.
+
+#include <chrono>
+#include <fstream>
+#include <thread>
+
+#include "src/formats/samples_csv.h"
+#include "virtual_robot_rig.h"
+
+namespace cdpr::integration {
+namespace {
+
+TEST(FullCalibration, LargeRobotWith35WaypointsFindsTheAnchorsWithin10cm) {
+  // GIVEN the virtual large robot (physics 20x faster than real time, nominal anchors 1 m off) and the daemon
+  virtual_robot::VirtualRobotOptions options;
+  options.preset = sim::Preset::kLarge;
+  options.seed = 1;
+  options.time_scale = 20.0;
+  options.anchor_perturbation_m = 1.0;
+  VirtualRobotRig rig(options);
+  ASSERT_EQ(rig.config.calibrator.planner.waypoint_count, 35);
+
+  // WHEN the operator starts a calibration (once the nodes' heartbeats are in) and it runs to its end
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  ASSERT_TRUE(rig.ask("start")["ok"].boolean());
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(5);
+  calibctl::JsonValue status;
+  do {
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    status = rig.ask("status");
+  } while (status["running"].boolean() && std::chrono::steady_clock::now() < deadline);
+  rig.stop_daemon();
+  std::ofstream(rig.dir + "/samples.csv") << formats::format_samples_csv(rig.loop->machine().samples());
+  rig.keep_dir = true;  // for diagnosis, unless everything below passes
+
+  // THEN it committed a calibration from 35 settled waypoints
+  ASSERT_EQ(status["state"].string(), "done") << status["reason"].string() << " (samples in " << rig.dir << ")";
+  EXPECT_EQ(status["samples"].integer(), 35);
+  const auto current = rig.store->load_current();
+  ASSERT_TRUE(current && current->has_value());
+  const Calibration& calibration = (*current)->calibration;
+  // AND every anchor is within 0.10 m of the truth (the nominal ones were 1 m off)
+  const Truth& truth = rig.robot->truth();
+  for (int i = 0; i < kCableCount; ++i) {
+    const double error_m = (calibration.winches[i].anchor_world - truth.winches[i].anchor_world).norm();
+    const double offset_error_m = calibration.winches[i].offset_m - truth.winches[i].offset_m;
+    std::printf("cable %d: anchor error %.4f m, offset error %+.4f m\n", i, error_m, offset_error_m);
+    EXPECT_LT(error_m, 0.10) << "cable " << i;
+  }
+  rig.keep_dir = ::testing::Test::HasFailure();
+}
+
+}  // namespace
+}  // namespace cdpr::integration

@@ -1,0 +1,127 @@
+#pragma once
+// The whole daemon against the virtual robot, in one process over real
+// sockets: the virtual robot (tools/virtual-robot) on one thread, the
+// daemon's event loop (src/daemon/daemon_loop.h) with the real drivers on
+// another, and the test acting as calibctl through the control socket.
+
+#include <atomic>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "calibctl/control_client.h"
+#include "calibctl/json_value.h"
+#include "drivers/can/canopen_winch_bank.h"
+#include "drivers/clock/monotonic_clock.h"
+#include "drivers/modbus/modbus_load_cell.h"
+#include "drivers/pose/pose_stream_source.h"
+#include "src/daemon/daemon_loop.h"
+#include "virtual-robot/virtual_robot.h"
+
+namespace cdpr::integration {
+
+class NullNotifier final : public daemon::ServiceNotifier {
+ public:
+  void ready() override {}
+  void status(const std::string&) override {}
+  void watchdog() override {}
+  void stopping() override {}
+};
+
+// The daemon settings of the demo: the physics runs time_scale times faster,
+// so a shorter rest window suffices; speed limits allow for the preset's
+// per-reading pose noise (5 mm, 0.01 rad) seen through 1 s windows.
+inline daemon::DaemonConfig fast_daemon_config(const std::string& dir, const virtual_robot::VirtualRobot& robot) {
+  daemon::DaemonConfig config = daemon::default_daemon_config();
+  config.store.state_dir = dir + "/state";
+  config.control_socket = dir + "/control";
+  config.winches.endpoint = robot.can_endpoint();
+  config.load_cell.endpoint = robot.modbus_endpoint();
+  config.pose.endpoint = robot.pose_endpoint();
+  config.button.gpio = false;
+  config.calibrator.settle_timeout_us = 15'000'000;
+  config.calibrator.equilibrium.window_us = 1'000'000;
+  config.calibrator.equilibrium.max_speed_mps = 0.03;
+  config.calibrator.equilibrium.max_angular_rate_radps = 0.06;
+  return config;
+}
+
+class VirtualRobotRig {
+ public:
+  explicit VirtualRobotRig(virtual_robot::VirtualRobotOptions options) {
+    char pattern[] = "/tmp/cdpr-integration-XXXXXX";
+    dir = mkdtemp(pattern);
+    options.dir = dir + "/robot";
+    std::filesystem::create_directories(options.dir);
+    auto created = virtual_robot::VirtualRobot::create(options);
+    if (!created) ADD_FAILURE() << created.error();
+    robot = std::move(*created);
+    robot_thread = std::thread([this] { robot->run(stop_robot); });
+
+    config = fast_daemon_config(dir, *robot);
+    drivers::can::CanWinchBankConfig winch_config;
+    for (const daemon::WinchNodes& w : config.winches.winches) {
+      winch_config.winches.push_back({w.drive_node_id, w.encoder_node_id, w.encoder_m_per_count, w.drive_m_per_count});
+    }
+    winches = std::make_unique<drivers::can::CanopenWinchBank>(
+        winch_config, drivers::can::make_can_connector(config.winches.endpoint));
+    drivers::modbus::ModbusLoadCellConfig cell_config;
+    cell_config.endpoint = config.load_cell.endpoint;
+    load_cell = std::make_unique<drivers::modbus::ModbusLoadCell>(cell_config, clock);
+    pose = std::make_unique<drivers::pose::PoseStreamSource>(config.pose.endpoint, clock);
+    store = std::make_unique<store::CalibrationStore>(config.store);
+    EXPECT_TRUE(store->open());
+    loop = std::make_unique<daemon::DaemonLoop>(config, robot->nominal_robot(),
+                                                daemon::DaemonDevices{*winches, *load_cell, *pose, nullptr}, *store,
+                                                clock, notifier, nullptr);
+    const hal::Status started = loop->start();
+    EXPECT_TRUE(started.ok()) << started.to_string();
+    loop_thread = std::thread([this] { loop->run(stop_loop); });
+  }
+
+  ~VirtualRobotRig() {
+    stop_daemon();
+    stop_robot.store(true);
+    robot_thread.join();
+    if (!keep_dir) std::filesystem::remove_all(dir);
+  }
+
+  void stop_daemon() {
+    if (!loop_thread.joinable()) return;
+    stop_loop.store(true);
+    loop_thread.join();
+  }
+
+  // One request through a fresh client, parsed; a failed request is a test failure.
+  calibctl::JsonValue ask(const std::string& request) {
+    calibctl::ControlClient client;
+    std::string error, response;
+    EXPECT_TRUE(client.connect(config.control_socket, error)) << error;
+    EXPECT_TRUE(client.request(request, response, error)) << error;
+    auto value = calibctl::JsonValue::parse(response);
+    EXPECT_TRUE(value.has_value()) << response;
+    return value ? *value : calibctl::JsonValue{};
+  }
+
+  std::string dir;
+  bool keep_dir = false;
+  std::unique_ptr<virtual_robot::VirtualRobot> robot;
+  std::atomic<bool> stop_robot{false};
+  std::thread robot_thread;
+  daemon::DaemonConfig config;
+  drivers::MonotonicClock clock;
+  std::unique_ptr<drivers::can::CanopenWinchBank> winches;
+  std::unique_ptr<drivers::modbus::ModbusLoadCell> load_cell;
+  std::unique_ptr<drivers::pose::PoseStreamSource> pose;
+  std::unique_ptr<store::CalibrationStore> store;
+  NullNotifier notifier;
+  std::unique_ptr<daemon::DaemonLoop> loop;
+  std::atomic<bool> stop_loop{false};
+  std::thread loop_thread;
+};
+
+}  // namespace cdpr::integration
