@@ -2,33 +2,51 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace cdpr::virtual_robot {
 namespace {
 
-// Where the platform would hang if the cables were straight chords of
-// (1 - shrink) times the given lengths (orientation kept): Gauss-Newton on
-// |A_i - (p + R b_i)| = (1 - shrink) L_i. The forward equilibrium
-// (sim/equilibrium.h) starts by hanging each cable between its pulley and
-// the attachment at the initial pose, which needs every cable longer than
-// its chord there; a chord shorter by a sag-sized fraction gives such a
-// start close to the solution, even after a long move.
-Pose straight_cable_pose(const sim::TrueRobot& robot, const std::array<double, kCableCount>& length_m, double shrink,
-                         Pose pose) {
-  for (int iteration = 0; iteration < 20; ++iteration) {
-    Eigen::Matrix<double, kCableCount, 3> jacobian;
-    Eigen::Matrix<double, kCableCount, 1> residual;
-    for (int i = 0; i < kCableCount; ++i) {
-      const Eigen::Vector3d chord =
-          pose.transform(robot.robot.winches[i].attachment_platform) - robot.robot.winches[i].anchor_world;
-      residual(i) = chord.norm() - (1.0 - shrink) * length_m[i];
-      jacobian.row(i) = chord.normalized().transpose();
+// Where the platform would hang on straight chords of (1 - shrink) times
+// the given lengths, orientation kept: the lowest pose at which three chords
+// are exactly that long and the fourth is not longer (that cable sags more).
+// The forward equilibrium (sim/equilibrium.h) starts by hanging each cable
+// between its pulley and the attachment at the initial pose, which needs
+// every cable longer than its chord there; this gives such a start close to
+// the solution, even after a long move or with one cable much too long.
+// Falls back to `pose` when no three chords meet.
+Pose hanging_chord_pose(const sim::TrueRobot& robot, const std::array<double, kCableCount>& length_m, double shrink,
+                        const Pose& pose) {
+  const auto chord = [&](const Pose& p, int i) {
+    return (p.transform(robot.robot.winches[i].attachment_platform) - robot.robot.winches[i].anchor_world).eval();
+  };
+  Pose best = pose;
+  double best_z = std::numeric_limits<double>::infinity();
+  for (int skipped = 0; skipped < kCableCount; ++skipped) {
+    Pose p = pose;
+    p.position_world.z() -= 5.0;  // start below: Newton then finds the lower (hanging) intersection
+    bool converged = false;
+    for (int iteration = 0; iteration < 30 && !converged; ++iteration) {
+      Eigen::Matrix3d jacobian;
+      Eigen::Vector3d residual;
+      for (int row = 0, i = 0; i < kCableCount; ++i) {
+        if (i == skipped) continue;
+        const Eigen::Vector3d c = chord(p, i);
+        residual(row) = c.norm() - (1.0 - shrink) * length_m[i];
+        jacobian.row(row++) = c.normalized().transpose();
+      }
+      const Eigen::Vector3d step = jacobian.fullPivLu().solve(-residual);
+      if (!step.allFinite()) break;
+      p.position_world += step;
+      converged = step.norm() < 1e-9;
     }
-    const Eigen::Vector3d step = jacobian.colPivHouseholderQr().solve(-residual);
-    pose.position_world += step;
-    if (step.norm() < 1e-9) break;
+    const bool fourth_fits = chord(p, skipped).norm() <= (1.0 - shrink) * length_m[skipped];
+    if (converged && fourth_fits && p.position_world.z() < best_z) {
+      best = p;
+      best_z = p.position_world.z();
+    }
   }
-  return pose;
+  return best;
 }
 
 }  // namespace
@@ -80,10 +98,14 @@ void RobotPhysics::solve_rest() {
   // rest pose; start from straight-cable poses then (tighter chords first).
   for (const double shrink : {1e-3, 3e-3, 1e-2}) {
     if (next) break;
-    const Pose guess = straight_cable_pose(robot_, unstretched_m, shrink, rest_.world_T_platform);
+    const Pose guess = hanging_chord_pose(robot_, unstretched_m, shrink, rest_.world_T_platform);
     next = sim::solve_forward_equilibrium(robot_, unstretched_m, guess, solver);
   }
   if (!next) {
+    // Back off: a configuration without a taut rest pose (a cable slack on
+    // the way) costs several failed solves, which would stall the real-time
+    // loop if retried at the full rate.
+    since_solve_s_ = -9.0 * options_.equilibrium_interval_s;
     ++failed_solves_;
     return;  // keep the last rest state; a later solve from the moved cables may succeed
   }
