@@ -73,9 +73,15 @@ RobotPhysics::RobotPhysics(const sim::TrueRobot& robot, const sim::Equilibrium& 
 
 void RobotPhysics::advance(double dt_s) {
   if (dt_s <= 0.0) return;
-  const double step_m = options_.winch_speed_mps * dt_s;
+  // Coordinated motion, as the robot's motion controller runs it: every
+  // winch arrives at the same time (the farthest at the profile speed), so
+  // the cable lengths pass through consistent sets and no cable goes slack
+  // between two taut rest poses.
+  double farthest_m = 0.0;
+  for (int i = 0; i < kCableCount; ++i) farthest_m = std::max(farthest_m, std::abs(target_m_[i] - payout_m_[i]));
+  const double fraction = farthest_m > 0.0 ? std::min(1.0, options_.winch_speed_mps * dt_s / farthest_m) : 1.0;
   for (int i = 0; i < kCableCount; ++i) {
-    payout_m_[i] += std::clamp(target_m_[i] - payout_m_[i], -step_m, step_m);
+    payout_m_[i] = fraction == 1.0 ? target_m_[i] : payout_m_[i] + fraction * (target_m_[i] - payout_m_[i]);
   }
   since_solve_s_ += dt_s;
   if (payout_m_ != solved_payout_m_ && since_solve_s_ >= options_.equilibrium_interval_s) solve_rest();

@@ -1,6 +1,7 @@
 #pragma once
-// The virtual robot's mechanics: four winches paying out cable at a profile
-// speed, and a platform that follows the TRUE static equilibrium of the
+// The virtual robot's mechanics: four winches paying out cable in
+// coordinated motion (all arrive together, the farthest at the profile
+// speed), and a platform that follows the TRUE static equilibrium of the
 // heavy cables (sim/equilibrium.h, solve_forward_equilibrium) with a
 // first-order lag, so it swings into place and settles like the real one.
 //
