@@ -5,6 +5,8 @@
 #include <memory>
 
 #include "solver/cable_prediction.h"
+#include "solver/effect_pose_factor.h"
+#include "solver/factor_parameters.h"
 #include "solver/initial_guess.h"
 #include "solver/pose_prior_factor.h"
 #include "solver/rigid_encoder_factor.h"
@@ -24,6 +26,20 @@ std::string check_inputs(const Robot& robot, const std::vector<Sample>& samples)
   }
   if (robot.reference_cable < 0 || robot.reference_cable >= kCableCount) return "reference cable index out of range";
   if (samples.size() < 3) return "need at least 3 samples, got " + std::to_string(samples.size());
+  return {};
+}
+
+std::string check_effects(const CalibrationOptions& options) {
+  if (!options.effects.empty() && options.cable_model != CableModelKind::kCatenary) {
+    return "model terms (effects) need the catenary cable model";
+  }
+  for (std::size_t a = 0; a < options.effects.size(); ++a) {
+    for (std::size_t b = a + 1; b < options.effects.size(); ++b) {
+      if (options.effects[a] == options.effects[b]) {
+        return "model term " + std::string(effect_model_name(options.effects[a])) + " given twice";
+      }
+    }
+  }
   return {};
 }
 
@@ -122,7 +138,17 @@ void fill_fit_rms(const Robot& robot, const std::vector<Sample>& samples, const 
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const Key pose_key = PoseKey(static_cast<int>(k));
     const Pose pose = problem.pose(pose_key);
-    if (options.cable_model == CableModelKind::kCatenary) {
+    if (!options.effects.empty()) {
+      // The model terms change lengths and readings: ask the factor's own model.
+      const EffectPoseFactor factor(robot, static_cast<int>(k), samples[k], options.height_sigma_m, Loss{},
+                                    options.effects);
+      PosePrediction prediction;
+      if (!factor.predict(parameter_blocks(problem, factor).data(), prediction)) continue;
+      for (int i = 0; i < kCableCount; ++i) sum_encoder += std::pow(prediction.encoder_residual_m[i], 2);
+      n_encoder += kCableCount;
+      sum_force += std::pow(prediction.force_residual_n, 2);
+      ++n_force;
+    } else if (options.cable_model == CableModelKind::kCatenary) {
       const Eigen::Vector2d force = problem.vector(ReferenceForceKey(static_cast<int>(k)));
       const auto cables = predict_cables(robot, anchors, pose, force);
       if (!cables) continue;
@@ -152,7 +178,9 @@ void fill_fit_rms(const Robot& robot, const std::vector<Sample>& samples, const 
 BuiltProblem build_calibration_problem(const Robot& robot, const std::vector<Sample>& all_samples,
                                        const CalibrationOptions& options) {
   BuiltProblem built;
-  if (std::string why = check_inputs(robot, all_samples); !why.empty()) {
+  std::string why = check_inputs(robot, all_samples);
+  if (why.empty()) why = check_effects(options);
+  if (!why.empty()) {
     built.message = why;
     return built;
   }
@@ -196,6 +224,7 @@ BuiltProblem build_calibration_problem(const Robot& robot, const std::vector<Sam
     problem.add_vector(AnchorKey(i), nominal[i]);
     problem.add_vector(OffsetKey(i), Eigen::Matrix<double, 1, 1>(offsets[i]));
   }
+  for (Effect e : options.effects) problem.add_vector(EffectKey(e), Eigen::VectorXd::Zero(effect_dimension(e)));
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const int pose_index = static_cast<int>(k);
     problem.add_pose(PoseKey(pose_index), start_poses[k]);
@@ -203,8 +232,13 @@ BuiltProblem build_calibration_problem(const Robot& robot, const std::vector<Sam
                                                          robot.noise.position_m, robot.noise.orientation_rad, loss));
     if (catenary) {
       problem.add_vector(ReferenceForceKey(pose_index), forces[k]);
-      problem.add_factor(
-          std::make_unique<StaticPoseFactor>(robot, pose_index, samples[k], options.height_sigma_m, loss));
+      if (options.effects.empty()) {
+        problem.add_factor(
+            std::make_unique<StaticPoseFactor>(robot, pose_index, samples[k], options.height_sigma_m, loss));
+      } else {
+        problem.add_factor(std::make_unique<EffectPoseFactor>(robot, pose_index, samples[k], options.height_sigma_m,
+                                                              loss, options.effects));
+      }
     } else {
       for (int i = 0; i < kCableCount; ++i) {
         problem.add_factor(std::make_unique<RigidEncoderFactor>(
@@ -243,10 +277,23 @@ CalibrationResult calibrate_once(const Robot& robot, const std::vector<Sample>& 
     globals.push_back(AnchorKey(i));
     globals.push_back(OffsetKey(i));
   }
+  for (Effect e : options.effects) globals.push_back(EffectKey(e));
   const Eigen::MatrixXd covariance = lm.covariance(globals);
 
   Calibration& cal = result.calibration;
   cal.model = {catenary ? "catenary" : "rigid"};
+  for (int base = 4 * kCableCount; Effect e : options.effects) {
+    FittedEffect fitted{e, {}, {}};
+    const Eigen::VectorXd value = problem.vector(EffectKey(e));
+    for (int j = 0; j < effect_dimension(e); ++j) {
+      fitted.value.push_back(value(j));
+      fitted.sigma.push_back(covariance.size() > 0 ? std::sqrt(covariance(base + j, base + j)) : 0.0);
+    }
+    base += effect_dimension(e);
+    cal.model.emplace_back(effect_model_name(e));
+    add_effect_values(e, fitted.value, fitted.sigma, cal.effects);
+    result.effects.push_back(std::move(fitted));
+  }
   cal.samples = static_cast<int>(samples.size());
   cal.winches.resize(kCableCount);
   for (int i = 0; i < kCableCount; ++i) {

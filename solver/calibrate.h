@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "solver/calibration.h"
+#include "solver/effects.h"
 #include "solver/levenberg_marquardt.h"
 #include "solver/problem.h"
 #include "solver/robot.h"
@@ -26,7 +27,17 @@ struct CalibrationOptions {
   // Sigma [m] of the attachment-height consistency of Eq. (15): a model
   // identity, not a sensor, so it is held much tighter than the pose noise.
   double height_sigma_m = 1e-2;
+  // Model terms fitted on top of the catenary (solver/effects.h), each with
+  // its own EffectKey variable started at 0 ("absent"); catenary only.
+  std::vector<Effect> effects;
   std::function<void(const IterationSummary&)> progress;  // may be empty
+};
+
+// One fitted model term in the solver's parameter units (solver/effects.h).
+struct FittedEffect {
+  Effect effect = Effect::kElasticity;
+  std::vector<double> value;
+  std::vector<double> sigma;  // 1-sigma from the covariance
 };
 
 struct CalibrationResult {
@@ -35,6 +46,7 @@ struct CalibrationResult {
   Calibration calibration;  // filled when ok (created/robot left to the caller)
   SolverSummary solver;
   std::vector<int> rejected_samples;  // sample ids refused before the solve, with reasons in message
+  std::vector<FittedEffect> effects;  // in CalibrationOptions::effects order, when ok
 };
 
 // The factor graph of one calibration at its data-driven start, for

@@ -11,15 +11,6 @@
 namespace cdpr {
 namespace {
 
-Sample sample_at(const Pose& pose) {
-  Sample s;
-  s.position_world = pose.position_world;
-  s.world_R_platform = pose.world_R_platform;
-  s.encoder_m = {150.0, 160.0, 170.0, 180.0};
-  s.force_n = 600.0;
-  return s;
-}
-
 std::vector<test::TestVariable> static_pose_variables(const Robot& robot, const Pose& pose, const Eigen::Vector2d& f) {
   std::vector<test::TestVariable> vars = {test::pose_variable(pose.position_world, pose.world_R_platform),
                                           test::vector_variable({f.x(), f.y()})};
@@ -33,7 +24,7 @@ std::vector<test::TestVariable> static_pose_variables(const Robot& robot, const 
 
 void check_static_pose_factor(const Robot& robot, const Eigen::Vector3d& position, double huber) {
   const Pose pose = test::tilted_pose(position);
-  const Sample sample = sample_at(pose);
+  const Sample sample = test::sample_at(pose);
   const auto anchors = test::anchors_of(robot);
   const auto force = refine_reference_force(robot, anchors, sample,
                                             paper_reference_force_guess(robot, anchors, sample), 1e-3);

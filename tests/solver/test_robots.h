@@ -47,6 +47,17 @@ inline Pose tilted_pose(const Eigen::Vector3d& position) {
   return pose;
 }
 
+// A measurement at `pose` with plausible readings of the large robot, for
+// Jacobian checks (the values need not be consistent).
+inline Sample sample_at(const Pose& pose) {
+  Sample s;
+  s.position_world = pose.position_world;
+  s.world_R_platform = pose.world_R_platform;
+  s.encoder_m = {150.0, 160.0, 170.0, 180.0};
+  s.force_n = 600.0;
+  return s;
+}
+
 inline std::array<Eigen::Vector3d, 4> anchors_of(const Robot& robot) {
   std::array<Eigen::Vector3d, 4> anchors;
   for (int i = 0; i < 4; ++i) anchors[i] = robot.winches[i].anchor_world;

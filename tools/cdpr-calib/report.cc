@@ -23,7 +23,9 @@ void print_summary(std::FILE* out, const CalibrationResult& result, const Robot&
   }
   if (!result.ok) return;
   const Calibration& cal = result.calibration;
-  std::fprintf(out, "samples used: %d   model: %s\n", cal.samples, cal.model.empty() ? "?" : cal.model[0].c_str());
+  std::string model;
+  for (const std::string& term : cal.model) model += (model.empty() ? "" : ",") + term;
+  std::fprintf(out, "samples used: %d   model: %s\n", cal.samples, model.empty() ? "?" : model.c_str());
   std::fprintf(out, "rms encoder residual: %.4f m (noise %.4f m)   rms force residual: %.3f N (noise %.3f N)\n",
                cal.fit.rms_encoder_m, robot.noise.encoder_m, cal.fit.rms_force_n, robot.noise.force_n);
   std::fprintf(out, "%-6s %32s %28s %18s\n", "cable", "anchor [m]", "anchor sigma [m]", "offset +- sigma [m]");
@@ -32,6 +34,20 @@ void print_summary(std::FILE* out, const CalibrationResult& result, const Robot&
     std::fprintf(out, "%-6zu %10.4f %10.4f %10.4f   %8.4f %8.4f %8.4f   %9.4f +- %.4f\n", i, w.anchor_world.x(),
                  w.anchor_world.y(), w.anchor_world.z(), w.anchor_sigma.x(), w.anchor_sigma.y(), w.anchor_sigma.z(),
                  w.offset_m, w.offset_sigma_m);
+  }
+  print_effects(out, cal.effects);
+}
+
+void print_effects(std::FILE* out, const EffectValues& effects) {
+  for (const auto& [name, values] : effects) {
+    if (name.ends_with("_sigma")) continue;
+    const auto sigma = effects.find(name + "_sigma");
+    std::fprintf(out, "effect %-16s", name.c_str());
+    for (std::size_t j = 0; j < values.size(); ++j) {
+      std::fprintf(out, " %.6g", values[j]);
+      if (sigma != effects.end() && j < sigma->second.size()) std::fprintf(out, " +- %.2g", sigma->second[j]);
+    }
+    std::fprintf(out, "\n");
   }
 }
 
@@ -51,6 +67,10 @@ void print_truth_comparison(std::FILE* out, const Calibration& calibration, cons
     offset_sum += std::abs(offset_err);
   }
   if (n > 0) std::fprintf(out, "mean   %14.4f %14.4f\n", anchor_sum / n, offset_sum / n);
+  if (!truth.effects.empty()) {
+    std::fprintf(out, "true effects:\n");
+    print_effects(out, truth.effects);
+  }
 }
 
 std::string utc_timestamp_now() {

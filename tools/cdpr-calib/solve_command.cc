@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "model_option.h"
 #include "report.h"
 #include "src/formats/calibration_toml.h"
 #include "src/formats/robot_toml.h"
@@ -17,8 +18,11 @@ void add_solve_command(CLI::App& app, SolveArgs& args) {
   solve->add_option("samples", args.samples_path, "samples.csv: one row per static pose")
       ->required()->check(CLI::ExistingFile);
   solve->add_option("-o,--output", args.output_path, "where to write calibration.toml")->capture_default_str();
-  solve->add_option("--model", args.model, "cable model: catenary (heavy sagging cable) or rigid (straight, massless)")
-      ->check(CLI::IsMember({"catenary", "rigid"}))->capture_default_str();
+  solve->add_option("--model", args.model,
+                    "cable model: catenary (heavy sagging cable) or rigid (straight, massless), optionally followed "
+                    "by model terms, comma-separated: " + effect_names_text() +
+                        " (e.g. catenary,elasticity,force_bias); fitted terms go to [effects]")
+      ->check(model_validator())->capture_default_str();
   solve->add_option("--huber", args.huber_width,
                     "robust Huber loss width in sigma units (0 = plain least squares)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
@@ -47,7 +51,9 @@ int run_solve(const SolveArgs& args) {
                samples->size(), args.model.c_str());
 
   CalibrationOptions options;
-  options.cable_model = args.model == "rigid" ? CableModelKind::kRigid : CableModelKind::kCatenary;
+  const ModelChoice model = *parse_model(args.model);
+  options.cable_model = model.cable_model;
+  options.effects = model.effects;
   options.huber_width = args.huber_width;
   options.height_sigma_m = args.height_sigma_m;
   options.max_iterations = args.max_iterations;

@@ -1,0 +1,67 @@
+#include "solver/effects.h"
+
+#include <cmath>
+
+namespace cdpr {
+
+std::string_view effect_model_name(Effect e) {
+  switch (e) {
+    case Effect::kElasticity: return "elasticity";
+    case Effect::kEncoderScale: return "encoder_scale";
+    case Effect::kForceBias: return "force_bias";
+    case Effect::kForceGain: return "force_gain";
+    case Effect::kComOffset: return "com_offset";
+    case Effect::kDensityError: return "density_error";
+    case Effect::kPulleyRadius: return "pulley_radius";
+  }
+  return "?";
+}
+
+std::string_view effect_value_name(Effect e) {
+  return e == Effect::kElasticity ? std::string_view("axial_stiffness") : effect_model_name(e);
+}
+
+std::optional<Effect> effect_from_model_name(std::string_view name) {
+  for (Effect e : kAllEffects) {
+    if (effect_model_name(e) == name) return e;
+  }
+  return std::nullopt;
+}
+
+int effect_dimension(Effect e) {
+  switch (e) {
+    case Effect::kEncoderScale: return 4;
+    case Effect::kComOffset: return 3;
+    default: return 1;
+  }
+}
+
+std::string_view effect_description(Effect e) {
+  switch (e) {
+    case Effect::kElasticity: return "cable elasticity: encoders count unstretched cable (elastic catenary, EA)";
+    case Effect::kEncoderScale: return "encoder scale per cable: reading = (1 + s_i) payout + offset";
+    case Effect::kForceBias: return "load-cell bias: reading = tension + b";
+    case Effect::kForceGain: return "load-cell gain: reading = (1 + g) tension";
+    case Effect::kComOffset: return "centre-of-mass offset: the weight acts at the nominal CoM + c";
+    case Effect::kDensityError: return "cable density error: density = nominal (1 + r)";
+    case Effect::kPulleyRadius: return "swivel-pulley radius: the cable wraps a pulley of radius r at the anchor";
+  }
+  return "?";
+}
+
+void add_effect_values(Effect e, const std::vector<double>& parameter, const std::vector<double>& parameter_sigma,
+                       EffectValues& out) {
+  const std::string name(effect_value_name(e));
+  if (e == Effect::kElasticity) {
+    // EA = 1 / (kappa * 1e-6); sigma by first order: sigma_EA = sigma_kappa * EA / kappa.
+    const double kappa = parameter.at(0);
+    const double ea = 1.0 / (kappa * kComplianceScale);
+    out[name] = {ea};
+    out[name + "_sigma"] = {std::abs(ea / kappa) * parameter_sigma.at(0)};
+    return;
+  }
+  out[name] = parameter;
+  out[name + "_sigma"] = parameter_sigma;
+}
+
+}  // namespace cdpr

@@ -1,0 +1,66 @@
+#pragma once
+// The optional model terms (effects) of DESIGN.md "Model terms": their names
+// in calibration.toml (`model = [...]` and [effects]), the size of their
+// parameter variable (EffectKey) and how a fitted parameter becomes the
+// physical value written to [effects].
+//
+// Parameters as the solver sees them (chosen so that 0 means "absent" and
+// every term is smooth through 0):
+//   elasticity     kappa = 1e6 / EA  [1/MN]   compliance; [effects] axial_stiffness = EA [N]
+//   encoder_scale  s_i (4)                   reading = (1 + s_i) * payout + offset_i
+//   force_bias     b [N]                     load cell reads (1 + g) * tension + b
+//   force_gain     g
+//   com_offset     c (3) [m, platform frame] weight acts at nominal CoM + c
+//   density_error  r                         cable density = nominal * (1 + r)
+//   pulley_radius  r [m]                     swivel pulley (DESIGN.md)
+
+#include <array>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "solver/calibration.h"
+#include "solver/keys.h"
+
+namespace cdpr {
+
+enum class Effect : int {
+  kElasticity,
+  kEncoderScale,
+  kForceBias,
+  kForceGain,
+  kComOffset,
+  kDensityError,
+  kPulleyRadius,
+};
+inline constexpr int kEffectCount = 7;
+inline constexpr std::array<Effect, kEffectCount> kAllEffects = {
+    Effect::kElasticity, Effect::kEncoderScale, Effect::kForceBias,   Effect::kForceGain,
+    Effect::kComOffset,  Effect::kDensityError, Effect::kPulleyRadius};
+
+// Compliance unit of the elasticity parameter: kappa [1/MN] = 1e6 / EA [N].
+inline constexpr double kComplianceScale = 1e-6;
+
+inline Key EffectKey(Effect e) { return EffectKey(static_cast<int>(e)); }
+
+// Name in `model = [...]` and on the command line: "elasticity",
+// "encoder_scale", "force_bias", "force_gain", "com_offset",
+// "density_error", "pulley_radius".
+std::string_view effect_model_name(Effect e);
+std::optional<Effect> effect_from_model_name(std::string_view name);
+// Size of the effect's parameter vector (1, 3 or 4).
+int effect_dimension(Effect e);
+// One-line physics, for reports.
+std::string_view effect_description(Effect e);
+
+// [effects] entries of one fitted effect: its physical value under its
+// FORMATS.md/truth.toml name (axial_stiffness, encoder_scale, force_bias,
+// force_gain, com_offset, density_error, pulley_radius) and the 1-sigma under
+// that name + "_sigma" (first order through the parameter's covariance).
+void add_effect_values(Effect e, const std::vector<double>& parameter, const std::vector<double>& parameter_sigma,
+                       EffectValues& out);
+// The physical value's [effects] name (axial_stiffness for elasticity, else the model name).
+std::string_view effect_value_name(Effect e);
+
+}  // namespace cdpr
