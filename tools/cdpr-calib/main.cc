@@ -1,6 +1,7 @@
 // cdpr-calib: offline calibration tools for cable-driven parallel robots.
 #include <CLI/CLI.hpp>
 
+#include "diagnose_command.h"
 #include "solve_command.h"
 
 int main(int argc, char** argv) {
@@ -8,7 +9,10 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   cdpr::tools::SolveArgs solve_args;
   cdpr::tools::add_solve_command(app, solve_args);
+  cdpr::tools::DiagnoseArgs diagnose_args;
+  cdpr::tools::add_diagnose_command(app, diagnose_args);
   CLI11_PARSE(app, argc, argv);
   if (app.got_subcommand("solve")) return cdpr::tools::run_solve(solve_args);
+  if (app.got_subcommand("diagnose")) return cdpr::tools::run_diagnose(diagnose_args);
   return 1;
 }

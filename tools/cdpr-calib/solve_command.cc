@@ -4,10 +4,9 @@
 #include <fstream>
 
 #include "model_option.h"
+#include "input_files.h"
 #include "report.h"
 #include "src/formats/calibration_toml.h"
-#include "src/formats/robot_toml.h"
-#include "src/formats/samples_csv.h"
 
 namespace cdpr::tools {
 
@@ -37,16 +36,10 @@ void add_solve_command(CLI::App& app, SolveArgs& args) {
 }
 
 int run_solve(const SolveArgs& args) {
-  const auto robot = formats::read_robot_toml(args.robot_path);
-  if (!robot) {
-    std::fprintf(stderr, "cdpr-calib: %s\n", robot.error().message().c_str());
-    return 1;
-  }
-  const auto samples = formats::read_samples_csv(args.samples_path, robot->cable_count());
-  if (!samples) {
-    std::fprintf(stderr, "cdpr-calib: %s\n", samples.error().message().c_str());
-    return 1;
-  }
+  const std::optional<CalibrationInputs> inputs = read_inputs(args.robot_path, args.samples_path);
+  if (!inputs) return 1;
+  const Robot* const robot = &inputs->robot;
+  const std::vector<Sample>* const samples = &inputs->samples;
   std::fprintf(stdout, "robot %s: %d cables, %zu samples, model %s\n", robot->name.c_str(), robot->cable_count(),
                samples->size(), args.model.c_str());
 

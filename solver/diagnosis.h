@@ -1,0 +1,72 @@
+#pragma once
+// The model-discrepancy workflow (DESIGN.md "Model terms"): fit the current
+// model on a training split, measure how well it predicts the held-out poses,
+// try each candidate effect (solver/effects.h) and add the one whose held-out
+// chi-square drops the most, if that drop is significant; repeat until no
+// candidate is; then say whether the held-out misfit is still above the noise.
+//
+// Evidence is held-out only: a candidate with k parameters is significant when
+// chi2_held_out(current) - chi2_held_out(with candidate) exceeds the
+// chi-square(k) quantile at level alpha / m (Bonferroni over the m candidates
+// tried in the round). Held-out chi2 is a predictive likelihood: a term that
+// only fits training noise makes it worse, not better.
+// Pure numerics: progress goes through a callback.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "solver/calibrate.h"
+#include "solver/held_out.h"
+
+namespace cdpr {
+
+struct DiagnosisOptions {
+  CalibrationOptions fit;  // base options; `effects` is the starting model (usually empty)
+  std::vector<Effect> candidates{kAllEffects.begin(), kAllEffects.end()};
+  int holdout_every = 3;     // every n-th sample (by order) is held out
+  double alpha = 0.01;       // family-wise significance per round
+  int max_added = 4;         // at most this many effects are added
+  // The held-out misfit counts as unexplained structure when sqrt(chi2/dof)
+  // exceeds this and chi2 is significant at `alpha` against its dof.
+  double structure_ratio = 1.2;
+  std::function<void(const std::string&)> progress;  // one line per fit; may be empty
+};
+
+struct CandidateScore {
+  Effect effect = Effect::kElasticity;
+  bool evaluated = false;      // fitted and evaluated on the held-out poses
+  std::string failure;         // why not, when !evaluated
+  double held_out_chi2 = 0.0;
+  double held_out_drop = 0.0;  // chi2 of the current model minus chi2 with this effect
+  double threshold = 0.0;      // the drop that counts as significant
+  bool significant = false;
+};
+
+struct DiagnosisStep {
+  std::vector<Effect> model;  // effects in the model at this step
+  Effect added = Effect::kElasticity;  // the effect this step added (not for step 0)
+  CalibrationResult fit;       // on the training split
+  HeldOutEvaluation held_out;  // of that fit
+  std::vector<CandidateScore> candidates;  // tried from this step, best first
+};
+
+struct Diagnosis {
+  bool ok = false;
+  std::string message;  // why the workflow could not run
+  std::vector<Sample> training, held_out;
+  std::vector<DiagnosisStep> steps;  // steps[0] is the starting model
+  bool structure_remains = false;
+  double structure_p_value = 1.0;    // of the final held-out chi2 against its dof
+  CalibrationResult final_fit;       // the final model on all samples
+};
+
+Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const DiagnosisOptions& options);
+
+// Upper quantile of the chi-square distribution with k degrees of freedom:
+// the x with P(X > x) = p (Wilson-Hilferty; a few percent at k = 1).
+double chi_square_upper_quantile(double p, int k);
+// P(X > x) for X ~ chi-square(k) (Wilson-Hilferty).
+double chi_square_upper_tail(double x, int k);
+
+}  // namespace cdpr

@@ -1,0 +1,24 @@
+#pragma once
+// The report of `cdpr-calib diagnose`: plain text (also printed) and an HTML
+// page with inline SVG residual plots of the held-out poses before (the
+// starting model) and after (the final model).
+
+#include <optional>
+#include <string>
+
+#include "solver/calibration.h"
+#include "solver/diagnosis.h"
+
+namespace cdpr::tools {
+
+struct ReportContext {
+  std::string robot_name;
+  NoiseSigmas noise;
+  int holdout_every = 3;
+  std::optional<Truth> truth;  // simulated data: anchor errors and true effect values
+};
+
+std::string diagnosis_text(const Diagnosis& diagnosis, const ReportContext& context);
+std::string diagnosis_html(const Diagnosis& diagnosis, const ReportContext& context);
+
+}  // namespace cdpr::tools
