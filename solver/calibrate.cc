@@ -279,6 +279,8 @@ CalibrationResult calibrate_once(const Robot& robot, const std::vector<Sample>& 
   }
   for (Effect e : options.effects) globals.push_back(EffectKey(e));
   const Eigen::MatrixXd covariance = lm.covariance(globals);
+  result.global_keys = globals;
+  result.global_covariance = covariance;
 
   Calibration& cal = result.calibration;
   cal.model = {catenary ? "catenary" : "rigid"};

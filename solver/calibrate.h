@@ -47,6 +47,10 @@ struct CalibrationResult {
   SolverSummary solver;
   std::vector<int> rejected_samples;  // sample ids refused before the solve, with reasons in message
   std::vector<FittedEffect> effects;  // in CalibrationOptions::effects order, when ok
+  // Covariance (tangent) of the global variables, in global_keys order:
+  // AnchorKey(i), OffsetKey(i) per cable, then each effect's EffectKey.
+  std::vector<Key> global_keys;
+  Eigen::MatrixXd global_covariance;
 };
 
 // The factor graph of one calibration at its data-driven start, for

@@ -87,8 +87,8 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
                 (current.fit.ok ? current.held_out.message : current.fit.message);
     return d;
   }
-  report(options, "fit " + model_text(model) + ": held-out chi2 " + fixed(current.held_out.chi2, 1) + " / dof " +
-                      std::to_string(current.held_out.dof) + ", normalized rms " +
+  report(options, "fit " + model_text(model) + ": held-out chi2 " + fixed(current.held_out.chi2, 1) + ", expected " +
+                      fixed(current.held_out.expected_chi2, 1) + ", normalized rms " +
                       fixed(current.held_out.normalized_rms(), 3));
   d.steps.push_back({model, Effect::kElasticity, current.fit, current.held_out, {}});
 
@@ -147,7 +147,8 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
   }
 
   const HeldOutEvaluation& last = d.steps.back().held_out;
-  d.structure_p_value = chi_square_upper_tail(last.chi2, last.dof);
+  // The excess over the expected chi2 as a chi-square(dof) scaled to that mean.
+  d.structure_p_value = chi_square_upper_tail(last.chi2 * last.dof / last.expected_chi2, last.dof);
   d.structure_remains = last.normalized_rms() > options.structure_ratio && d.structure_p_value < options.alpha;
   report(options, d.structure_remains ? "structure remains that no known effect explains"
                                       : "no structure left above the noise");

@@ -27,8 +27,9 @@ struct DiagnosisOptions {
   int holdout_every = 3;     // every n-th sample (by order) is held out
   double alpha = 0.01;       // family-wise significance per round
   int max_added = 4;         // at most this many effects are added
-  // The held-out misfit counts as unexplained structure when sqrt(chi2/dof)
-  // exceeds this and chi2 is significant at `alpha` against its dof.
+  // The held-out misfit counts as unexplained structure when its normalized
+  // rms (HeldOutEvaluation) exceeds this and chi2 is significant at `alpha`
+  // against its expected value.
   double structure_ratio = 1.2;
   std::function<void(const std::string&)> progress;  // one line per fit; may be empty
 };

@@ -83,8 +83,7 @@ bool EffectPoseFactor::predict(const double* const* parameters, PosePrediction& 
 bool EffectPoseFactor::evaluate_model(const double* const* parameters, double* residual, double* const* jacobians,
                                       PosePrediction* prediction) const {
   const double* scale = effect_parameter(parameters, Effect::kEncoderScale);
-  const double* bias = effect_parameter(parameters, Effect::kForceBias);
-  const double* gain = effect_parameter(parameters, Effect::kForceGain);
+  const double* load_cell = effect_parameter(parameters, Effect::kLoadCell);  // (bias, gain)
   const double* com = effect_parameter(parameters, Effect::kComOffset);
   const double* density = effect_parameter(parameters, Effect::kDensityError);
   const double* kappa = effect_parameter(parameters, Effect::kElasticity);
@@ -154,9 +153,9 @@ bool EffectPoseFactor::evaluate_model(const double* const* parameters, double* r
   // Eq. (16) with the load cell's bias and gain.
   const int force_row = 2 * kCableCount;
   const double tension = in.reference_force.norm();
-  const double force_gain = 1.0 + (gain ? gain[0] : 0.0);
+  const double force_gain = 1.0 + (load_cell ? load_cell[1] : 0.0);
   const double sigma_force = robot_.noise.force_n;
-  residual[force_row] = (force_gain * tension + (bias ? bias[0] : 0.0) - force_n_) / sigma_force;
+  residual[force_row] = (force_gain * tension + (load_cell ? load_cell[0] : 0.0) - force_n_) / sigma_force;
   if (prediction) prediction->force_residual_n = residual[force_row] * sigma_force;
   if (with_jacobian) {
     StatRow row = StatRow::Zero();
@@ -165,8 +164,10 @@ bool EffectPoseFactor::evaluate_model(const double* const* parameters, double* r
       row(kStaticsForce + 1) = force_gain * in.reference_force.y() / (tension * sigma_force);
     }
     scatter_statics(row, force_row, jacobians, com_block);
-    if (double* J = effect_jacobian(jacobians, Effect::kForceBias)) J[force_row] = 1.0 / sigma_force;
-    if (double* J = effect_jacobian(jacobians, Effect::kForceGain)) J[force_row] = tension / sigma_force;
+    if (double* J = effect_jacobian(jacobians, Effect::kLoadCell)) {
+      J[force_row * 2] = 1.0 / sigma_force;
+      J[force_row * 2 + 1] = tension / sigma_force;
+    }
   }
   return true;
 }

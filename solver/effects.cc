@@ -8,8 +8,7 @@ std::string_view effect_model_name(Effect e) {
   switch (e) {
     case Effect::kElasticity: return "elasticity";
     case Effect::kEncoderScale: return "encoder_scale";
-    case Effect::kForceBias: return "force_bias";
-    case Effect::kForceGain: return "force_gain";
+    case Effect::kLoadCell: return "load_cell";
     case Effect::kComOffset: return "com_offset";
     case Effect::kDensityError: return "density_error";
     case Effect::kPulleyRadius: return "pulley_radius";
@@ -17,8 +16,10 @@ std::string_view effect_model_name(Effect e) {
   return "?";
 }
 
-std::string_view effect_value_name(Effect e) {
-  return e == Effect::kElasticity ? std::string_view("axial_stiffness") : effect_model_name(e);
+std::vector<std::string> effect_value_names(Effect e) {
+  if (e == Effect::kElasticity) return {"axial_stiffness"};
+  if (e == Effect::kLoadCell) return {"force_bias", "force_gain"};
+  return {std::string(effect_model_name(e))};
 }
 
 std::optional<Effect> effect_from_model_name(std::string_view name) {
@@ -32,6 +33,7 @@ int effect_dimension(Effect e) {
   switch (e) {
     case Effect::kEncoderScale: return 4;
     case Effect::kComOffset: return 3;
+    case Effect::kLoadCell: return 2;
     default: return 1;
   }
 }
@@ -40,8 +42,7 @@ std::string_view effect_description(Effect e) {
   switch (e) {
     case Effect::kElasticity: return "cable elasticity: encoders count unstretched cable (elastic catenary, EA)";
     case Effect::kEncoderScale: return "encoder scale per cable: reading = (1 + s_i) payout + offset";
-    case Effect::kForceBias: return "load-cell bias: reading = tension + b";
-    case Effect::kForceGain: return "load-cell gain: reading = (1 + g) tension";
+    case Effect::kLoadCell: return "load-cell bias and gain: reading = (1 + g) tension + b";
     case Effect::kComOffset: return "centre-of-mass offset: the weight acts at the nominal CoM + c";
     case Effect::kDensityError: return "cable density error: density = nominal (1 + r)";
     case Effect::kPulleyRadius: return "swivel-pulley radius: the cable wraps a pulley of radius r at the anchor";
@@ -51,7 +52,14 @@ std::string_view effect_description(Effect e) {
 
 void add_effect_values(Effect e, const std::vector<double>& parameter, const std::vector<double>& parameter_sigma,
                        EffectValues& out) {
-  const std::string name(effect_value_name(e));
+  const std::string name = effect_value_names(e).front();
+  if (e == Effect::kLoadCell) {
+    out["force_bias"] = {parameter.at(0)};
+    out["force_bias_sigma"] = {parameter_sigma.at(0)};
+    out["force_gain"] = {parameter.at(1)};
+    out["force_gain_sigma"] = {parameter_sigma.at(1)};
+    return;
+  }
   if (e == Effect::kElasticity) {
     // EA = 1 / (kappa * 1e-6); sigma by first order: sigma_EA = sigma_kappa * EA / kappa.
     const double kappa = parameter.at(0);

@@ -8,8 +8,10 @@
 // every term is smooth through 0):
 //   elasticity     kappa = 1e6 / EA  [1/MN]   compliance; [effects] axial_stiffness = EA [N]
 //   encoder_scale  s_i (4)                   reading = (1 + s_i) * payout + offset_i
-//   force_bias     b [N]                     load cell reads (1 + g) * tension + b
-//   force_gain     g
+//   load_cell      (b [N], g)                load cell reads (1 + g) * tension + b
+//                                            ([effects] force_bias, force_gain: one term, as in
+//                                            DESIGN.md, since over the tensions of a calibration
+//                                            a bias and a gain are hard to tell apart)
 //   com_offset     c (3) [m, platform frame] weight acts at nominal CoM + c
 //   density_error  r                         cable density = nominal * (1 + r)
 //   pulley_radius  r [m]                     swivel pulley (DESIGN.md)
@@ -28,15 +30,14 @@ namespace cdpr {
 enum class Effect : int {
   kElasticity,
   kEncoderScale,
-  kForceBias,
-  kForceGain,
+  kLoadCell,
   kComOffset,
   kDensityError,
   kPulleyRadius,
 };
-inline constexpr int kEffectCount = 7;
+inline constexpr int kEffectCount = 6;
 inline constexpr std::array<Effect, kEffectCount> kAllEffects = {
-    Effect::kElasticity, Effect::kEncoderScale, Effect::kForceBias,   Effect::kForceGain,
+    Effect::kElasticity, Effect::kEncoderScale, Effect::kLoadCell,
     Effect::kComOffset,  Effect::kDensityError, Effect::kPulleyRadius};
 
 // Compliance unit of the elasticity parameter: kappa [1/MN] = 1e6 / EA [N].
@@ -45,22 +46,22 @@ inline constexpr double kComplianceScale = 1e-6;
 inline Key EffectKey(Effect e) { return EffectKey(static_cast<int>(e)); }
 
 // Name in `model = [...]` and on the command line: "elasticity",
-// "encoder_scale", "force_bias", "force_gain", "com_offset",
+// "encoder_scale", "load_cell", "com_offset",
 // "density_error", "pulley_radius".
 std::string_view effect_model_name(Effect e);
 std::optional<Effect> effect_from_model_name(std::string_view name);
-// Size of the effect's parameter vector (1, 3 or 4).
+// Size of the effect's parameter vector (1 to 4).
 int effect_dimension(Effect e);
 // One-line physics, for reports.
 std::string_view effect_description(Effect e);
 
-// [effects] entries of one fitted effect: its physical value under its
-// FORMATS.md/truth.toml name (axial_stiffness, encoder_scale, force_bias,
-// force_gain, com_offset, density_error, pulley_radius) and the 1-sigma under
-// that name + "_sigma" (first order through the parameter's covariance).
+// [effects] entries of one fitted effect: its physical values under their
+// FORMATS.md/truth.toml names (axial_stiffness, encoder_scale, force_bias and
+// force_gain, com_offset, density_error, pulley_radius) and each 1-sigma
+// under that name + "_sigma" (first order through the parameter's covariance).
 void add_effect_values(Effect e, const std::vector<double>& parameter, const std::vector<double>& parameter_sigma,
                        EffectValues& out);
-// The physical value's [effects] name (axial_stiffness for elasticity, else the model name).
-std::string_view effect_value_name(Effect e);
+// The [effects] names of the effect's physical values, in add_effect_values order.
+std::vector<std::string> effect_value_names(Effect e);
 
 }  // namespace cdpr

@@ -3,10 +3,87 @@
 #include <cmath>
 
 #include "solver/factor_parameters.h"
+#include "solver/pose_prior_factor.h"
 
 namespace cdpr {
 
-double HeldOutEvaluation::normalized_rms() const { return dof > 0 ? std::sqrt(chi2 / dof) : 0.0; }
+double HeldOutEvaluation::normalized_rms() const {
+  return expected_chi2 > 0.0 ? std::sqrt(chi2 / expected_chi2) : 0.0;
+}
+
+namespace {
+
+int tangent_dim(const Key& key) {
+  switch (key.kind) {
+    case VariableKind::kPose: return 6;
+    case VariableKind::kReferenceForce: return 2;
+    case VariableKind::kAnchor: return 3;
+    case VariableKind::kOffset: return 1;
+    case VariableKind::kEffect: return effect_dimension(static_cast<Effect>(key.index));
+  }
+  return 0;
+}
+
+// Column of each of the factor's keys in the training covariance, -1 for the pose's own variables.
+std::vector<int> global_columns(const EffectPoseFactor& factor, const CalibrationResult& trained) {
+  std::vector<int> columns;
+  for (const Key& key : factor.keys()) {
+    int column = 0, found = -1;
+    for (const Key& global : trained.global_keys) {
+      if (global == key) found = column;
+      column += tangent_dim(global);
+    }
+    columns.push_back(found);
+  }
+  return columns;
+}
+
+// tr(H Sigma) of one held-out pose: its residuals' Jacobian J = [J_l J_g]
+// over its own variables l (pose 6, reference force 2) and the globals g,
+// H = J_g^T J_g - J_g^T J_l (J_l^T J_l)^-1 J_l^T J_g (l eliminated).
+// Zero when the pose cannot be evaluated.
+double predictive_inflation(const EffectPoseFactor& factor, const PosePriorFactor& prior,
+                            const std::vector<const double*>& blocks, const CalibrationResult& trained,
+                            const std::vector<int>& global_column) {
+  const int p = static_cast<int>(trained.global_covariance.rows());
+  constexpr int kLocal = 8, kRows = EffectPoseFactor::kResidualDim + 6;
+  Eigen::MatrixXd j_local = Eigen::MatrixXd::Zero(kRows, kLocal), j_global = Eigen::MatrixXd::Zero(kRows, p);
+  const std::span<const Key> keys = factor.keys();
+  std::vector<std::vector<double>> storage(keys.size());
+  std::vector<double*> jacobians(keys.size());
+  std::vector<int> dims(keys.size());
+  for (std::size_t b = 0; b < keys.size(); ++b) {
+    dims[b] = tangent_dim(keys[b]);
+    storage[b].assign(EffectPoseFactor::kResidualDim * dims[b], 0.0);
+    jacobians[b] = storage[b].data();
+  }
+  std::array<double, EffectPoseFactor::kResidualDim> residual;
+  double cost = 0.0;
+  if (!factor.evaluate(blocks.data(), residual.data(), jacobians.data(), &cost)) return 0.0;
+  for (std::size_t b = 0; b < keys.size(); ++b) {
+    for (int r = 0; r < EffectPoseFactor::kResidualDim; ++r) {
+      for (int c = 0; c < dims[b]; ++c) {
+        const double v = storage[b][r * dims[b] + c];
+        if (b == 0) j_local(r, c) = v;
+        else if (b == 1) j_local(r, 6 + c) = v;
+        else if (global_column[b] >= 0) j_global(r, global_column[b] + c) = v;
+      }
+    }
+  }
+  std::array<double, 36> prior_jacobian{};
+  double* prior_blocks[1] = {prior_jacobian.data()};
+  std::array<double, 6> prior_residual;
+  if (!prior.evaluate(blocks.data(), prior_residual.data(), prior_blocks, &cost)) return 0.0;
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) j_local(EffectPoseFactor::kResidualDim + r, c) = prior_jacobian[r * 6 + c];
+  }
+  const Eigen::MatrixXd lg = j_local.transpose() * j_global;
+  const Eigen::MatrixXd h = j_global.transpose() * j_global -
+                            lg.transpose() * (j_local.transpose() * j_local).ldlt().solve(lg);
+  return h.cwiseProduct(trained.global_covariance).sum();
+}
+
+}  // namespace
 
 HeldOutEvaluation evaluate_held_out(const Robot& robot, const std::vector<Sample>& held_out,
                                     const CalibrationOptions& options, const CalibrationResult& trained) {
@@ -47,7 +124,7 @@ HeldOutEvaluation evaluate_held_out(const Robot& robot, const std::vector<Sample
     return out;
   }
 
-  double sum_encoder = 0.0, sum_height = 0.0, sum_force = 0.0;
+  double sum_encoder = 0.0, sum_height = 0.0, sum_force = 0.0, inflation = 0.0;
   int residual_count = 0;
   for (std::size_t k = 0; k < built.samples.size(); ++k) {
     const int pose_index = static_cast<int>(k);
@@ -64,6 +141,9 @@ HeldOutEvaluation evaluate_held_out(const Robot& robot, const std::vector<Sample
     }
     sum_force += std::pow(pose.prediction.force_residual_n, 2);
     residual_count += EffectPoseFactor::kResidualDim + 6;  // + the pose prior
+    const PosePriorFactor prior(pose_index, {built.samples[k].position_world, built.samples[k].world_R_platform},
+                                robot.noise.position_m, robot.noise.orientation_rad, Loss{});
+    inflation += predictive_inflation(factor, prior, blocks, trained, global_columns(factor, trained));
     out.poses.push_back(pose);
   }
   if (out.poses.empty()) {
@@ -78,6 +158,7 @@ HeldOutEvaluation evaluate_held_out(const Robot& robot, const std::vector<Sample
   // each pose has 8 unknowns of its own (pose 6, reference force 2).
   out.chi2 = 2.0 * summary.final_cost;
   out.dof = residual_count - 8 * static_cast<int>(out.poses.size());
+  out.expected_chi2 = out.dof + inflation;
   out.ok = true;
   return out;
 }

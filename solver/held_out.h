@@ -31,7 +31,12 @@ struct HeldOutEvaluation {
   double rms_encoder_m = 0.0;
   double rms_height_m = 0.0;
   double rms_force_n = 0.0;
-  // sqrt(chi2 / dof): 1 when the misfit is the sensor noise alone.
+  // What chi2 would be on average if the model were right: dof plus the
+  // misfit the training fit's own uncertainty causes, tr(H_held_out Sigma_train)
+  // (H: the held-out poses' information on the global parameters with their
+  // own variables eliminated; Sigma: the training covariance).
+  double expected_chi2 = 0.0;
+  // sqrt(chi2 / expected_chi2): 1 at the noise floor.
   double normalized_rms() const;
 };
 

@@ -16,8 +16,7 @@ std::vector<double> effect_value(Effect e) {
   switch (e) {
     case Effect::kElasticity: return {0.67};  // EA = 1.5e6 N
     case Effect::kEncoderScale: return {0.003, -0.002, 0.001, 0.004};
-    case Effect::kForceBias: return {15.0};
-    case Effect::kForceGain: return {0.02};
+    case Effect::kLoadCell: return {15.0, 0.02};
     case Effect::kComOffset: return {0.05, -0.03, 0.02};
     case Effect::kDensityError: return {0.05};
     case Effect::kPulleyRadius: return {0.15};
@@ -94,13 +93,13 @@ TEST(EffectPoseFactor, WithoutEffectsEqualsTheBaseFactor) {
 TEST(EffectPoseFactor, PredictionReportsPhysicalResiduals) {
   const Robot robot = test::large_robot();
   const PoseSetup s = setup_for(robot, {100, 80, 12});
-  const EffectPoseFactor factor(robot, 0, s.sample, 1e-3, Loss{}, {Effect::kForceBias});
-  auto vars = variables(robot, s, {Effect::kForceBias});
+  const EffectPoseFactor factor(robot, 0, s.sample, 1e-3, Loss{}, {Effect::kLoadCell});
+  auto vars = variables(robot, s, {Effect::kLoadCell});
   std::vector<const double*> params;
   for (const auto& v : vars) params.push_back(v.ambient.data());
   PosePrediction with_bias;
   ASSERT_TRUE(factor.predict(params.data(), with_bias));
-  vars.back().ambient[0] = 0.0;
+  vars.back().ambient = {0.0, 0.02};
   params.back() = vars.back().ambient.data();
   PosePrediction without;
   ASSERT_TRUE(factor.predict(params.data(), without));

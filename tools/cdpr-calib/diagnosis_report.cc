@@ -59,8 +59,9 @@ double mean_anchor_error(const Calibration& cal, const Truth& truth) {
 }
 
 void append_held_out(std::string& out, const HeldOutEvaluation& h) {
-  append(out, "  held out: normalized rms %.3f (1 = noise floor; chi2 %.1f / dof %d), rms encoder %.4f m, height %.4f m, "
-              "force %.2f N\n", h.normalized_rms(), h.chi2, h.dof, h.rms_encoder_m, h.rms_height_m, h.rms_force_n);
+  append(out, "  held out: normalized rms %.3f (chi2 %.1f, expected %.1f with dof %d), rms encoder %.4f m, "
+              "height %.4f m, force %.2f N\n", h.normalized_rms(), h.chi2, h.expected_chi2, h.dof, h.rms_encoder_m,
+         h.rms_height_m, h.rms_force_n);
 }
 
 void append_trends(std::string& out, const HeldOutEvaluation& h, int count) {
@@ -80,7 +81,8 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
   append(out, "cdpr-calib diagnose: robot %s, %zu samples: %zu training, %zu held out (one in every %d)\n",
          c.robot_name.c_str(), d.training.size() + d.held_out.size(), d.training.size(), d.held_out.size(),
          c.holdout_every);
-  append(out, "noise: encoder %.4f m, force %.2f N; the held-out normalized rms is sqrt(chi2/dof), 1 at the noise floor\n",
+  append(out, "noise: encoder %.4f m, force %.2f N; held-out normalized rms = sqrt(chi2 / expected chi2 of a right "
+              "model), 1 at the noise floor\n",
          c.noise.encoder_m, c.noise.force_n);
   if (!d.ok) {
     append(out, "diagnosis failed: %s\n", d.message.c_str());
@@ -90,12 +92,12 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
     const DiagnosisStep& step = d.steps[s];
     append(out, "\nstep %zu: %s\n", s, model_text(step.model).c_str());
     if (s > 0) {
-      const std::string name(effect_value_name(step.added));
-      append(out, "  added %s: %s = %s\n", std::string(effect_model_name(step.added)).c_str(), name.c_str(),
-             values_text(step.fit.calibration.effects, name).c_str());
-      if (c.truth) {
+      append(out, "  added %s:\n", std::string(effect_model_name(step.added)).c_str());
+      for (const std::string& name : effect_value_names(step.added)) {
+        append(out, "    %s = %s\n", name.c_str(), values_text(step.fit.calibration.effects, name).c_str());
+        if (!c.truth) continue;
         const auto real = c.truth->effects.find(name);
-        append(out, "  truth: %s; fitted value %.1f sigma from it\n",
+        append(out, "      truth: %s; fitted value %.1f sigma from it\n",
                real == c.truth->effects.end() ? "not in the data (0)" : values_text(c.truth->effects, name).c_str(),
                sigma_distance(step.fit.calibration.effects, c.truth->effects, name));
       }
@@ -140,8 +142,9 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
   if (d.final_fit.ok) {
     append(out, "final model on all samples: %s\n", model_text(last.model).c_str());
     for (Effect e : last.model) {
-      const std::string name(effect_value_name(e));
-      append(out, "  %s = %s\n", name.c_str(), values_text(d.final_fit.calibration.effects, name).c_str());
+      for (const std::string& name : effect_value_names(e)) {
+        append(out, "  %s = %s\n", name.c_str(), values_text(d.final_fit.calibration.effects, name).c_str());
+      }
     }
     if (c.truth) {
       append(out, "  mean anchor error against truth: %.4f m\n", mean_anchor_error(d.final_fit.calibration, *c.truth));

@@ -20,7 +20,7 @@ void add_solve_command(CLI::App& app, SolveArgs& args) {
   solve->add_option("--model", args.model,
                     "cable model: catenary (heavy sagging cable) or rigid (straight, massless), optionally followed "
                     "by model terms, comma-separated: " + effect_names_text() +
-                        " (e.g. catenary,elasticity,force_bias); fitted terms go to [effects]")
+                        " (e.g. catenary,elasticity,load_cell); fitted terms go to [effects]")
       ->check(model_validator())->capture_default_str();
   solve->add_option("--huber", args.huber_width,
                     "robust Huber loss width in sigma units (0 = plain least squares)")
