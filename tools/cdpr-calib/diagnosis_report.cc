@@ -74,6 +74,29 @@ void append_trends(std::string& out, const HeldOutEvaluation& h, int count) {
   }
 }
 
+// One machine-readable line for scripts (tools/diagnose-acceptance.sh).
+void append_summary(std::string& out, const Diagnosis& d, const ReportContext& c) {
+  std::string added;
+  for (std::size_t s = 1; s < d.steps.size(); ++s) {
+    added += (added.empty() ? "" : ",") + std::string(effect_model_name(d.steps[s].added));
+  }
+  append(out, "summary: added=%s structure=%s normalized_rms_start=%.4f normalized_rms_final=%.4f",
+         added.empty() ? "none" : added.c_str(), d.structure_remains ? "remains" : "none",
+         d.steps.front().held_out.normalized_rms(), d.steps.back().held_out.normalized_rms());
+  if (c.truth && d.final_fit.ok) {
+    // Of the final fit on all samples: anchors, and the largest |fitted - true| / sigma over the added effects.
+    double worst = 0.0;
+    for (std::size_t s = 1; s < d.steps.size(); ++s) {
+      for (const std::string& name : effect_value_names(d.steps[s].added)) {
+        worst = std::max(worst, sigma_distance(d.final_fit.calibration.effects, c.truth->effects, name));
+      }
+    }
+    append(out, " anchor_error_final=%.4f effect_sigma_distance=%.2f", mean_anchor_error(d.final_fit.calibration, *c.truth),
+           worst);
+  }
+  append(out, "\n");
+}
+
 }  // namespace
 
 std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
@@ -85,7 +108,7 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
               "model), 1 at the noise floor\n",
          c.noise.encoder_m, c.noise.force_n);
   if (!d.ok) {
-    append(out, "diagnosis failed: %s\n", d.message.c_str());
+    append(out, "diagnosis failed: %s\nsummary: failed\n", d.message.c_str());
     return out;
   }
   for (std::size_t s = 0; s < d.steps.size(); ++s) {
@@ -152,6 +175,7 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
   } else {
     append(out, "final fit on all samples failed: %s\n", d.final_fit.message.c_str());
   }
+  append_summary(out, d, c);
   return out;
 }
 
