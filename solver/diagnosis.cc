@@ -31,20 +31,79 @@ std::string fixed(double value, int digits) {
   return buffer;
 }
 
-struct Fitted {
-  CalibrationResult fit;
-  HeldOutEvaluation held_out;
-};
+bool same_poses(const HeldOutEvaluation& a, const HeldOutEvaluation& b) {
+  if (a.poses.size() != b.poses.size()) return false;
+  for (std::size_t j = 0; j < a.poses.size(); ++j) {
+    if (a.poses[j].sample.id != b.poses[j].sample.id) return false;
+  }
+  return true;
+}
 
-Fitted fit_and_evaluate(const Robot& robot, const Diagnosis& d, const DiagnosisOptions& options,
-                        const std::vector<Effect>& model) {
+// Mean per-pose chi2 drop from `current` to `candidate` over its standard
+// error; the poses are matched by order (both pool the same folds).
+double paired_t(const HeldOutEvaluation& current, const HeldOutEvaluation& candidate) {
+  const std::size_t n = std::min(current.poses.size(), candidate.poses.size());
+  if (n < 3) return 0.0;
+  double mean = 0.0, square = 0.0;
+  for (std::size_t j = 0; j < n; ++j) mean += (current.poses[j].chi2 - candidate.poses[j].chi2) / n;
+  for (std::size_t j = 0; j < n; ++j) square += std::pow(current.poses[j].chi2 - candidate.poses[j].chi2 - mean, 2);
+  const double standard_error = std::sqrt(square / (n - 1) / n);
+  return standard_error > 0.0 ? mean / standard_error : 0.0;
+}
+
+// Pools one fold's held-out evaluation into the total.
+void pool(HeldOutEvaluation& total, HeldOutEvaluation&& part) {
+  const double n_total = static_cast<double>(total.poses.size()), n_part = static_cast<double>(part.poses.size());
+  const auto mean_square = [&](double a, double b) {
+    return std::sqrt((a * a * n_total + b * b * n_part) / std::max(1.0, n_total + n_part));
+  };
+  total.rms_encoder_m = mean_square(total.rms_encoder_m, part.rms_encoder_m);
+  total.rms_height_m = mean_square(total.rms_height_m, part.rms_height_m);
+  total.rms_force_n = mean_square(total.rms_force_n, part.rms_force_n);
+  total.chi2 += part.chi2;
+  total.expected_chi2 += part.expected_chi2;
+  total.dof += part.dof;
+  total.rejected_samples.insert(total.rejected_samples.end(), part.rejected_samples.begin(), part.rejected_samples.end());
+  for (HeldOutPose& pose : part.poses) total.poses.push_back(std::move(pose));
+}
+
+// Cross-validated held-out evaluation of one model; `ok` false with the
+// first failure's reason.
+HeldOutEvaluation cross_validate(const Robot& robot, const std::vector<Sample>& samples,
+                                 const DiagnosisOptions& options, const std::vector<Effect>& model) {
   CalibrationOptions fit_options = options.fit;
   fit_options.effects = model;
   fit_options.progress = nullptr;
-  Fitted f;
-  f.fit = calibrate(robot, d.training, fit_options);
-  if (f.fit.ok) f.held_out = evaluate_held_out(robot, d.held_out, fit_options, f.fit);
-  return f;
+  HeldOutEvaluation total;
+  total.ok = true;
+  for (int fold = 0; fold < options.folds; ++fold) {
+    std::vector<Sample> training, held_out;
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+      (static_cast<int>(k % options.folds) == fold ? held_out : training).push_back(samples[k]);
+    }
+    const CalibrationResult fit = calibrate(robot, training, fit_options);
+    if (!fit.ok) {
+      total.ok = false;
+      total.message = "fold " + std::to_string(fold) + ": training fit failed: " + fit.message;
+      return total;
+    }
+    HeldOutEvaluation part = evaluate_held_out(robot, held_out, fit_options, fit);
+    if (!part.ok) {
+      total.ok = false;
+      total.message = "fold " + std::to_string(fold) + ": " + part.message;
+      return total;
+    }
+    pool(total, std::move(part));
+  }
+  return total;
+}
+
+CalibrationResult fit_all(const Robot& robot, const std::vector<Sample>& samples, const DiagnosisOptions& options,
+                          const std::vector<Effect>& model) {
+  CalibrationOptions fit_options = options.fit;
+  fit_options.effects = model;
+  fit_options.progress = nullptr;
+  return calibrate(robot, samples, fit_options);
 }
 
 void report(const DiagnosisOptions& options, const std::string& line) {
@@ -68,29 +127,27 @@ double chi_square_upper_quantile(double p, int k) {
 
 Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const DiagnosisOptions& options) {
   Diagnosis d;
-  if (options.holdout_every < 2) {
-    d.message = "holdout_every must be at least 2";
+  if (options.folds < 2 || static_cast<std::size_t>(options.folds) > samples.size()) {
+    d.message = "need 2 to " + std::to_string(samples.size()) + " cross-validation folds, got " +
+                std::to_string(options.folds);
     return d;
   }
-  for (std::size_t k = 0; k < samples.size(); ++k) {
-    const bool hold = static_cast<int>(k % options.holdout_every) == options.holdout_every - 1;
-    (hold ? d.held_out : d.training).push_back(samples[k]);
-  }
-  report(options, "split: " + std::to_string(d.training.size()) + " training poses, " +
-                      std::to_string(d.held_out.size()) + " held out (one in every " +
-                      std::to_string(options.holdout_every) + ")");
+  d.sample_count = static_cast<int>(samples.size());
+  d.folds = options.folds;
+  report(options, std::to_string(samples.size()) + " samples, " + std::to_string(options.folds) +
+                      "-fold cross-validation");
 
   std::vector<Effect> model = options.fit.effects;
-  Fitted current = fit_and_evaluate(robot, d, options, model);
-  if (!current.fit.ok || !current.held_out.ok) {
+  CalibrationResult start_fit = fit_all(robot, samples, options, model);
+  HeldOutEvaluation start = start_fit.ok ? cross_validate(robot, samples, options, model) : HeldOutEvaluation{};
+  if (!start_fit.ok || !start.ok) {
     d.message = "the starting model " + model_text(model) + " could not be fitted: " +
-                (current.fit.ok ? current.held_out.message : current.fit.message);
+                (start_fit.ok ? start.message : start_fit.message);
     return d;
   }
-  report(options, "fit " + model_text(model) + ": held-out chi2 " + fixed(current.held_out.chi2, 1) + ", expected " +
-                      fixed(current.held_out.expected_chi2, 1) + ", normalized rms " +
-                      fixed(current.held_out.normalized_rms(), 3));
-  d.steps.push_back({model, Effect::kElasticity, current.fit, current.held_out, {}});
+  report(options, "fit " + model_text(model) + ": held-out chi2 " + fixed(start.chi2, 1) + ", expected " +
+                      fixed(start.expected_chi2, 1) + ", normalized rms " + fixed(start.normalized_rms(), 3));
+  d.steps.push_back({model, Effect::kElasticity, std::move(start_fit), std::move(start), {}});
 
   while (static_cast<int>(d.steps.size()) - 1 < options.max_added) {
     std::vector<Effect> untried;
@@ -100,32 +157,32 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
     if (untried.empty()) break;
     const double level = options.alpha / static_cast<double>(untried.size());
     std::vector<CandidateScore> scores;
-    std::vector<Fitted> fits;
+    std::vector<HeldOutEvaluation> evaluations;
     for (Effect e : untried) {
       std::vector<Effect> with = model;
       with.push_back(e);
-      Fitted f = fit_and_evaluate(robot, d, options, with);
+      HeldOutEvaluation f = cross_validate(robot, samples, options, with);
       CandidateScore score;
       score.effect = e;
-      score.threshold = chi_square_upper_quantile(level, effect_dimension(e));
-      if (!f.fit.ok) {
-        score.failure = "training fit failed: " + f.fit.message;
-      } else if (!f.held_out.ok) {
-        score.failure = "held-out evaluation failed: " + f.held_out.message;
-      } else if (f.held_out.poses.size() != d.steps.back().held_out.poses.size()) {
+      score.threshold = normal_upper_quantile(level);
+      if (!f.ok) {
+        score.failure = f.message;
+      } else if (!same_poses(f, d.steps.back().held_out)) {
         score.failure = "not comparable: a different number of held-out poses could be evaluated";
       } else {
         score.evaluated = true;
-        score.held_out_chi2 = f.held_out.chi2;
-        score.held_out_drop = d.steps.back().held_out.chi2 - f.held_out.chi2;
-        score.significant = score.held_out_drop > score.threshold;
+        score.held_out_chi2 = f.chi2;
+        score.held_out_drop = d.steps.back().held_out.chi2 - f.chi2;
+        score.t_statistic = paired_t(d.steps.back().held_out, f);
+        score.significant = score.t_statistic > score.threshold;
       }
       report(options, "  try " + std::string(effect_model_name(e)) + ": " +
-                          (score.evaluated ? "held-out chi2 drop " + fixed(score.held_out_drop, 1) + " (needs > " +
-                                                 fixed(score.threshold, 1) + ")"
+                          (score.evaluated ? "held-out chi2 drop " + fixed(score.held_out_drop, 1) + ", paired t " +
+                                                 fixed(score.t_statistic, 2) + " (needs > " +
+                                                 fixed(score.threshold, 2) + ")"
                                            : score.failure));
       scores.push_back(score);
-      fits.push_back(std::move(f));
+      evaluations.push_back(std::move(f));
     }
     // Best first: significant before not, then by the held-out drop.
     std::vector<std::size_t> order(scores.size());
@@ -138,12 +195,18 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
     const std::size_t best = order.front();
     if (!scores[best].significant) break;
 
-    model.push_back(scores[best].effect);
-    Fitted& chosen = fits[best];
+    std::vector<Effect> with = model;
+    with.push_back(scores[best].effect);
+    CalibrationResult fit = fit_all(robot, samples, options, with);
+    if (!fit.ok) {
+      report(options, "stop: " + model_text(with) + " cannot be fitted to all samples: " + fit.message);
+      break;
+    }
+    model = with;
     report(options, "add " + std::string(effect_model_name(scores[best].effect)) + ": held-out normalized rms " +
                         fixed(d.steps.back().held_out.normalized_rms(), 3) + " -> " +
-                        fixed(chosen.held_out.normalized_rms(), 3));
-    d.steps.push_back({model, scores[best].effect, std::move(chosen.fit), std::move(chosen.held_out), {}});
+                        fixed(evaluations[best].normalized_rms(), 3));
+    d.steps.push_back({model, scores[best].effect, std::move(fit), std::move(evaluations[best]), {}});
   }
 
   const HeldOutEvaluation& last = d.steps.back().held_out;
@@ -153,12 +216,7 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
   report(options, d.structure_remains ? "structure remains that no known effect explains"
                                       : "no structure left above the noise");
 
-  CalibrationOptions final_options = options.fit;
-  final_options.effects = model;
-  final_options.progress = nullptr;
-  d.final_fit = calibrate(robot, samples, final_options);
-  report(options, "final fit of " + model_text(model) + " on all " + std::to_string(samples.size()) +
-                      " samples: " + (d.final_fit.ok ? "ok" : d.final_fit.message));
+  d.final_fit = d.steps.back().fit;
   d.ok = true;
   return d;
 }

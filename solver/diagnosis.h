@@ -1,15 +1,19 @@
 #pragma once
-// The model-discrepancy workflow (DESIGN.md "Model terms"): fit the current
-// model on a training split, measure how well it predicts the held-out poses,
+// The model-discrepancy workflow (DESIGN.md "Model terms"): by k-fold
+// cross-validation, fit the current model without one fold of the samples
+// and measure how well it predicts that fold's poses, pooled over the folds;
 // try each candidate effect (solver/effects.h) and add the one whose held-out
 // chi-square drops the most, if that drop is significant; repeat until no
 // candidate is; then say whether the held-out misfit is still above the noise.
 //
-// Evidence is held-out only: a candidate with k parameters is significant when
-// chi2_held_out(current) - chi2_held_out(with candidate) exceeds the
-// chi-square(k) quantile at level alpha / m (Bonferroni over the m candidates
-// tried in the round). Held-out chi2 is a predictive likelihood: a term that
-// only fits training noise makes it worse, not better.
+// Evidence is held-out only. Held-out chi2 is a predictive log-likelihood (a
+// term that only fits training noise makes it worse, not better); a
+// candidate is significant when the per-pose drops d_j = chi2_j(current) -
+// chi2_j(with candidate) are positive beyond chance: a paired test
+// (Vuong's, for non-nested predictive likelihoods), mean(d) / (sd(d) / sqrt(n))
+// above the normal quantile at level alpha / m (Bonferroni over the m
+// candidates of the round). The spread of d is measured, not assumed, since
+// cross-validated drops vary more than a chi-square with k dof would.
 // Pure numerics: progress goes through a callback.
 
 #include <functional>
@@ -24,7 +28,7 @@ namespace cdpr {
 struct DiagnosisOptions {
   CalibrationOptions fit;  // base options; `effects` is the starting model (usually empty)
   std::vector<Effect> candidates{kAllEffects.begin(), kAllEffects.end()};
-  int holdout_every = 3;     // every n-th sample (by order) is held out
+  int folds = 3;             // cross-validation: sample k (by order) is held out in fold k % folds
   double alpha = 0.01;       // family-wise significance per round
   int max_added = 4;         // at most this many effects are added
   // The held-out misfit counts as unexplained structure when its normalized
@@ -40,26 +44,28 @@ struct CandidateScore {
   std::string failure;         // why not, when !evaluated
   double held_out_chi2 = 0.0;
   double held_out_drop = 0.0;  // chi2 of the current model minus chi2 with this effect
-  double threshold = 0.0;      // the drop that counts as significant
+  double t_statistic = 0.0;    // paired: mean per-pose drop over its standard error
+  double threshold = 0.0;      // the t that counts as significant
   bool significant = false;
 };
 
 struct DiagnosisStep {
   std::vector<Effect> model;  // effects in the model at this step
   Effect added = Effect::kElasticity;  // the effect this step added (not for step 0)
-  CalibrationResult fit;       // on the training split
-  HeldOutEvaluation held_out;  // of that fit
+  CalibrationResult fit;       // on all samples: the values reported for this model
+  HeldOutEvaluation held_out;  // pooled over the folds, each fold predicted by a fit without it
   std::vector<CandidateScore> candidates;  // tried from this step, best first
 };
 
 struct Diagnosis {
   bool ok = false;
   std::string message;  // why the workflow could not run
-  std::vector<Sample> training, held_out;
+  int sample_count = 0;
+  int folds = 0;
   std::vector<DiagnosisStep> steps;  // steps[0] is the starting model
   bool structure_remains = false;
   double structure_p_value = 1.0;    // of the final held-out chi2 against its dof
-  CalibrationResult final_fit;       // the final model on all samples
+  CalibrationResult final_fit;       // the final model on all samples (== steps.back().fit)
 };
 
 Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const DiagnosisOptions& options);

@@ -130,19 +130,25 @@ HeldOutEvaluation evaluate_held_out(const Robot& robot, const std::vector<Sample
     const int pose_index = static_cast<int>(k);
     const EffectPoseFactor factor(robot, pose_index, built.samples[k], options.height_sigma_m, Loss{}, options.effects);
     const std::vector<const double*> blocks = parameter_blocks(problem, factor);
-    HeldOutPose pose{built.samples[k], problem.pose(PoseKey(pose_index)), {}};
-    if (!factor.predict(blocks.data(), pose.prediction)) {
+    HeldOutPose pose{built.samples[k], problem.pose(PoseKey(pose_index)), {}, 0.0};
+    const PosePriorFactor prior(pose_index, {built.samples[k].position_world, built.samples[k].world_R_platform},
+                                robot.noise.position_m, robot.noise.orientation_rad, Loss{});
+    std::array<double, EffectPoseFactor::kResidualDim> residual;
+    std::array<double, 6> prior_residual;
+    double cost = 0.0, prior_cost = 0.0;
+    if (!factor.predict(blocks.data(), pose.prediction) ||
+        !factor.evaluate(blocks.data(), residual.data(), nullptr, &cost) ||
+        !prior.evaluate(blocks.data(), prior_residual.data(), nullptr, &prior_cost)) {
       out.rejected_samples.push_back(built.samples[k].id);
       continue;
     }
+    pose.chi2 = 2.0 * (cost + prior_cost);
     for (int i = 0; i < kCableCount; ++i) {
       sum_encoder += std::pow(pose.prediction.encoder_residual_m[i], 2);
       sum_height += std::pow(pose.prediction.height_residual_m[i], 2);
     }
     sum_force += std::pow(pose.prediction.force_residual_n, 2);
     residual_count += EffectPoseFactor::kResidualDim + 6;  // + the pose prior
-    const PosePriorFactor prior(pose_index, {built.samples[k].position_world, built.samples[k].world_R_platform},
-                                robot.noise.position_m, robot.noise.orientation_rad, Loss{});
     inflation += predictive_inflation(factor, prior, blocks, trained, global_columns(factor, trained));
     out.poses.push_back(pose);
   }

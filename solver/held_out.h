@@ -17,6 +17,7 @@ struct HeldOutPose {
   Sample sample;
   Pose world_T_platform;  // fitted
   PosePrediction prediction;
+  double chi2 = 0.0;  // this pose's squared whitened residuals, pose prior included
 };
 
 struct HeldOutEvaluation {

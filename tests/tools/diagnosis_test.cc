@@ -13,7 +13,7 @@
 namespace cdpr {
 namespace {
 
-// The large robot of the paper, 45 poses (30 training, 15 held out), nominal
+// The large robot of the paper, 45 poses (3-fold cross-validation), nominal
 // anchors 2 m off, the default sensor noise.
 sim::DatasetConfig large_robot(std::uint64_t seed) {
   sim::DatasetConfig c;

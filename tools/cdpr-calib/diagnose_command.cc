@@ -26,9 +26,9 @@ bool write_text(const std::filesystem::path& path, const std::string& text) {
 void add_diagnose_command(CLI::App& app, DiagnoseArgs& args) {
   CLI::App* cmd = app.add_subcommand(
       "diagnose",
-      "Find where the model and the data disagree: fit the catenary on a training split, rank the known model terms "
-      "by how much they improve the prediction of held-out poses, add the best while it is significant, and say when "
-      "structure remains that no known term explains");
+      "Find where the model and the data disagree: by cross-validation, rank the known model terms by how much they "
+      "improve the prediction of held-out poses, add the best while it is significant, and say when structure "
+      "remains that no known term explains");
   cmd->add_option("robot", args.robot_path, "robot.toml: nominal geometry, masses and sensor noise")
       ->required()->check(CLI::ExistingFile);
   cmd->add_option("samples", args.samples_path, "samples.csv: one row per static pose")
@@ -40,8 +40,9 @@ void add_diagnose_command(CLI::App& app, DiagnoseArgs& args) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--candidates", args.candidates, "comma-separated model terms to try (default all: " +
                                                        effect_names_text() + ")");
-  cmd->add_option("--holdout-every", args.holdout_every, "every n-th sample is held out for the evidence")
-      ->check(CLI::Range(2, 100))->capture_default_str();
+  cmd->add_option("--folds", args.folds,
+                  "cross-validation folds: each pose is predicted by a fit without its fold (sample k in fold k % n)")
+      ->check(CLI::Range(2, 20))->capture_default_str();
   cmd->add_option("--alpha", args.alpha, "family-wise significance level per round (Bonferroni over the candidates)")
       ->check(CLI::Range(1e-12, 0.5))->capture_default_str();
   cmd->add_option("--max-added", args.max_added, "add at most this many terms")
@@ -55,7 +56,7 @@ int run_diagnose(const DiagnoseArgs& args) {
   if (!inputs) return 1;
   const Robot* const robot = &inputs->robot;
   const std::vector<Sample>* const samples = &inputs->samples;
-  ReportContext context{robot->name, robot->noise, args.holdout_every, std::nullopt};
+  ReportContext context{robot->name, robot->noise, std::nullopt};
   if (!args.truth_path.empty()) {
     auto truth = formats::read_truth_toml(args.truth_path);
     if (!truth) {
@@ -67,7 +68,7 @@ int run_diagnose(const DiagnoseArgs& args) {
 
   DiagnosisOptions options;
   options.fit.height_sigma_m = args.height_sigma_m;
-  options.holdout_every = args.holdout_every;
+  options.folds = args.folds;
   options.alpha = args.alpha;
   options.max_added = args.max_added;
   if (!args.candidates.empty()) {

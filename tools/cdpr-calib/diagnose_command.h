@@ -15,7 +15,7 @@ struct DiagnoseArgs {
   std::string report_dir = "diagnosis";
   std::string truth_path;  // optional: simulated data
   std::string candidates;  // comma-separated model terms; empty = all
-  int holdout_every = 3;
+  int folds = 3;
   double alpha = 0.01;
   int max_added = 4;
   double height_sigma_m = 1e-2;

@@ -101,9 +101,8 @@ void append_summary(std::string& out, const Diagnosis& d, const ReportContext& c
 
 std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
   std::string out;
-  append(out, "cdpr-calib diagnose: robot %s, %zu samples: %zu training, %zu held out (one in every %d)\n",
-         c.robot_name.c_str(), d.training.size() + d.held_out.size(), d.training.size(), d.held_out.size(),
-         c.holdout_every);
+  append(out, "cdpr-calib diagnose: robot %s, %d samples, %d-fold cross-validation (each pose predicted by a fit "
+              "without its fold)\n", c.robot_name.c_str(), d.sample_count, d.folds);
   append(out, "noise: encoder %.4f m, force %.2f N; held-out normalized rms = sqrt(chi2 / expected chi2 of a right "
               "model), 1 at the noise floor\n",
          c.noise.encoder_m, c.noise.force_n);
@@ -129,14 +128,14 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
     if (c.truth) append(out, "  mean anchor error against truth: %.4f m\n", mean_anchor_error(step.fit.calibration, *c.truth));
     append_trends(out, step.held_out, 3);
     if (step.candidates.empty()) continue;
-    append(out, "  candidates (held-out chi2 drop, significant above the threshold):\n");
+    append(out, "  candidates (held-out chi2 drop; paired t of the per-pose drops, significant above the threshold):\n");
     for (const CandidateScore& cand : step.candidates) {
       const std::string name(effect_model_name(cand.effect));
       if (!cand.evaluated) {
         append(out, "    %-14s not evaluated: %s\n", name.c_str(), cand.failure.c_str());
       } else {
-        append(out, "    %-14s %10.1f  (threshold %.1f)%s\n", name.c_str(), cand.held_out_drop, cand.threshold,
-               cand.significant ? "  significant" : "");
+        append(out, "    %-14s %10.1f  t %6.2f (threshold %.2f)%s\n", name.c_str(), cand.held_out_drop, cand.t_statistic,
+               cand.threshold, cand.significant ? "  significant" : "");
       }
     }
   }

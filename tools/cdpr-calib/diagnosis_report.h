@@ -14,7 +14,6 @@ namespace cdpr::tools {
 struct ReportContext {
   std::string robot_name;
   NoiseSigmas noise;
-  int holdout_every = 3;
   std::optional<Truth> truth;  // simulated data: anchor errors and true effect values
 };
 
