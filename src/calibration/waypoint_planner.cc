@@ -10,10 +10,19 @@ namespace cdpr::calibration {
 namespace {
 
 // Why a solved rest pose violates a limit; empty when within all limits.
-std::string limit_violation(const StaticPose& rest, const std::array<double, kCableCount>& payout_m,
+std::string limit_violation(const Robot& robot, const std::array<Eigen::Vector3d, kCableCount>& anchors,
+                            const StaticPose& rest, const std::array<double, kCableCount>& payout_m,
                             const PlannerOptions& options) {
   for (int i = 0; i < kCableCount; ++i) {
     const std::string cable = "cable " + std::to_string(i);
+    const double chord_m =
+        (rest.world_T_platform.transform(robot.winches[i].attachment_platform) - anchors[i]).norm();
+    const double sag_excess = rest.arc_length_m[i] / chord_m - 1.0;
+    if (!(sag_excess <= options.max_sag_excess)) {
+      return cable + " sag excess " + significant(100.0 * sag_excess) + " % above " +
+             significant(100.0 * options.max_sag_excess) + " % (arc " + significant(rest.arc_length_m[i]) +
+             " m over chord " + significant(chord_m) + " m)";
+    }
     if (rest.tension_n[i] < options.min_tension_n) {
       return cable + " tension " + significant(rest.tension_n[i]) + " N below " +
              significant(options.min_tension_n) + " N";
@@ -117,6 +126,7 @@ std::string check_planner_options(const Robot& robot, const PlannerOptions& opti
   if (!(options.jitter_fraction >= 0.0 && options.jitter_fraction < 0.5)) return "jitter fraction must be in [0, 0.5)";
   if (!(options.z_min_m <= options.z_max_m)) return "z band is empty (z_min > z_max)";
   if (!(options.min_tension_n < options.max_tension_n)) return "tension limits are empty (min >= max)";
+  if (!(options.max_sag_excess > 0.0)) return "max sag excess must be > 0";
   const Box box = workspace_box(robot, options);
   if (!(box.low.x() < box.high.x() && box.low.y() < box.high.y())) {
     return "margin " + significant(options.margin_m) + " m leaves no workspace inside the anchors";
@@ -141,7 +151,7 @@ WaypointPlan plan_waypoints(const Robot& robot, const std::array<double, kCableC
     }
     Waypoint waypoint{std::move(*rest), {}};
     for (int i = 0; i < kCableCount; ++i) waypoint.payout_m[i] = waypoint.rest.arc_length_m[i] + payout_offset_m[i];
-    if (std::string why = limit_violation(waypoint.rest, waypoint.payout_m, options); !why.empty()) {
+    if (std::string why = limit_violation(robot, anchors, waypoint.rest, waypoint.payout_m, options); !why.empty()) {
       plan.rejected.push_back({position, std::move(why)});
       continue;
     }

@@ -9,7 +9,12 @@
 // (grid_xy x grid_xy x grid_z, jitter a fraction of the step, seeded so a plan
 // is reproducible). Every candidate is solved for its rest pose and checked:
 // each cable's tension within [min_tension_n, max_tension_n], each payout
-// target within [min_payout_m, max_payout_m]. From the feasible ones,
+// target within [min_payout_m, max_payout_m], and each cable's sag excess
+// (arc length over chord, minus one) at most max_sag_excess. The statics at
+// a given position can also be met by a cable hanging in a deep loop at low
+// tension (tens of metres of extra cable on the large robot): such a pose is
+// not where a controller would put the robot, the true robot cannot be led
+// there by paying out, and a small anchor error moves it far. From the feasible ones,
 // farthest-point selection picks `waypoint_count` (the first nearest the
 // box centre), then they are ordered greedily by travel from the start
 // position. Rejected candidates are returned with the reason.
@@ -44,6 +49,7 @@ struct PlannerOptions {
   double max_tension_n = 5000.0;
   double min_payout_m = -1e9;    // winch travel limits in encoder units [m]
   double max_payout_m = 1e9;
+  double max_sag_excess = 0.02;  // (arc length - chord) / chord, every cable
 };
 
 struct Waypoint {

@@ -186,7 +186,8 @@ void read_calibration(TomlReader& reader, ConfigReader& r, const toml::table& ro
   reader.check_keys(waypoints, p, {{"count", kOptional}, {"margin", kOptional}, {"z_min", kOptional},
                                    {"z_max", kOptional}, {"grid_xy", kOptional}, {"grid_z", kOptional},
                                    {"jitter", kOptional}, {"seed", kOptional}, {"min_tension", kOptional},
-                                   {"max_tension", kOptional}, {"min_payout", kOptional}, {"max_payout", kOptional}});
+                                   {"max_tension", kOptional}, {"min_payout", kOptional}, {"max_payout", kOptional},
+                                   {"max_sag_excess", kOptional}});
   r.integer(waypoints, "count", p, w.waypoint_count, 1, 10'000);
   r.number(waypoints, "margin", p, w.margin_m, Bound::kNonNegative);
   r.number(waypoints, "z_min", p, w.z_min_m, Bound::kAny);
@@ -201,6 +202,7 @@ void read_calibration(TomlReader& reader, ConfigReader& r, const toml::table& ro
   r.number(waypoints, "max_tension", p, w.max_tension_n, Bound::kPositive);
   r.number(waypoints, "min_payout", p, w.min_payout_m, Bound::kAny);
   r.number(waypoints, "max_payout", p, w.max_payout_m, Bound::kAny);
+  r.number(waypoints, "max_sag_excess", p, w.max_sag_excess, Bound::kPositive);
   if (w.jitter_fraction >= 0.5) r.fail(waypoints, "jitter", p, "must be in [0, 0.5)");
 
   const toml::table& eq = reader.table(root, "equilibrium", "", kOptional);

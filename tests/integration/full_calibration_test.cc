@@ -13,14 +13,7 @@
 namespace cdpr::integration {
 namespace {
 
-// DISABLED until it passes. Diagnosis (vrobot, 2026-11-23): the sampled rows
-// were garbage because the virtual robot's platform froze while the winches
-// moved (the simulator's forward equilibrium failed behind a slack cable).
-// Coordinated winch motion fixed most of it: now 27 of 35 rows are good; the
-// other 8 (two runs of 4) still freeze after the plan sends a cable far too
-// long (the waypoint planner commands e.g. 365 m or 620 m of cable 0 at some
-// waypoints), and the fit is refused (encoder rms 11.7 m).
-TEST(FullCalibration, DISABLED_LargeRobotWith35WaypointsFindsTheAnchorsWithin10cm) {
+TEST(FullCalibration, LargeRobotWith35WaypointsFindsTheAnchorsWithin10cm) {
   // GIVEN the virtual large robot (physics 20x faster than real time, nominal anchors 0.3 m off) and the daemon
   virtual_robot::VirtualRobotOptions options;
   options.preset = sim::Preset::kLarge;

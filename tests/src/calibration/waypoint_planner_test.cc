@@ -1,5 +1,6 @@
 #include "src/calibration/waypoint_planner.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -121,6 +122,35 @@ TEST(WaypointPlanner, PayoutLimitsRejectFarCandidatesAndTooFewFeasibleIsAProblem
   EXPECT_NE(plan.problem.find("of 200 waypoints feasible"), std::string::npos) << plan.problem;
   ASSERT_FALSE(plan.rejected.empty());
   EXPECT_NE(plan.rejected.front().reason.find("payout"), std::string::npos) << plan.rejected.front().reason;
+}
+
+TEST(WaypointPlanner, DeepSagPosesAreRejectedAndNoChosenCableSagsBeyondTheLimit) {
+  // GIVEN the large robot with the default sag limit, and the same with a limit only a few poses meet
+  const Robot robot = test::large_robot();
+  PlannerOptions options = large_options();
+  PlannerOptions tight = options;
+  tight.max_sag_excess = 2e-3;
+  tight.waypoint_count = 1;
+  // WHEN both are planned
+  const WaypointPlan plan = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), options);
+  const WaypointPlan tight_plan = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), tight);
+  // THEN no chosen cable is more than 2 % longer than its chord
+  ASSERT_TRUE(plan.ok()) << plan.problem;
+  for (const Waypoint& w : plan.waypoints) {
+    for (int i = 0; i < kCableCount; ++i) {
+      const double chord_m =
+          (w.rest.world_T_platform.transform(robot.winches[i].attachment_platform) - robot.winches[i].anchor_world)
+              .norm();
+      EXPECT_LE(w.rest.arc_length_m[i], (1.0 + options.max_sag_excess) * chord_m);
+    }
+  }
+  // AND the tight limit rejects candidates naming the cable, its arc and its chord
+  const auto sagging = std::find_if(tight_plan.rejected.begin(), tight_plan.rejected.end(), [](const auto& r) {
+    return r.reason.find("sag excess") != std::string::npos;
+  });
+  ASSERT_NE(sagging, tight_plan.rejected.end());
+  EXPECT_NE(sagging->reason.find("over chord"), std::string::npos) << sagging->reason;
+  EXPECT_NE(sagging->reason.find("cable "), std::string::npos) << sagging->reason;
 }
 
 TEST(WaypointPlanner, AMarginLeavingNoWorkspaceIsRefused) {

@@ -1,0 +1,69 @@
+// The daemon's plan, made from the nominal robot, must be one the TRUE robot
+// can follow: at every waypoint's payouts the true heavy cables have a taut
+// rest pose near the planned one. A plan that is not (a cable commanded far
+// too long, a pose near a singular corner) makes the platform hang wherever
+// it can and the sample describes a pose nobody planned, or none at all.
+
+#include <gtest/gtest.h>
+
+#include "sim/dataset.h"
+#include "sim/equilibrium.h"
+#include "sim/presets.h"
+#include "src/calibration/waypoint_planner.h"
+#include "src/daemon/daemon_config.h"
+#include "virtual-robot/robot_physics.h"
+
+namespace cdpr::integration {
+namespace {
+
+TEST(PlannedWaypoints, TheTrueLargeRobotRestsNearEveryWaypointPlannedFromNominalAnchors) {
+  // GIVEN the large robot, nominal anchors 0.3 m off, at rest in the middle of the workspace
+  sim::DatasetConfig config;
+  config.preset = sim::Preset::kLarge;
+  config.seed = 1;
+  config.pose_count = 1;
+  config.anchor_perturbation_m = 0.3;
+  const auto data = sim::simulate_dataset(config);
+  ASSERT_TRUE(data) << data.error();
+  const sim::TrueRobot& truth = data->true_robot;
+  const sim::PresetSpec spec = sim::preset_spec(sim::Preset::kLarge);
+  const Eigen::Vector3d start_world = 0.5 * (spec.workspace_min + spec.workspace_max);
+  const auto start = sim::solve_equilibrium(truth, start_world, 0.0);
+  ASSERT_TRUE(start) << start.error().message;
+  std::array<double, kCableCount> encoder_m{};
+  for (int i = 0; i < kCableCount; ++i) encoder_m[i] = start->cables[i].payout_m + truth.encoder_offset_m[i];
+
+  // WHEN the daemon (default settings) estimates the offsets there and plans
+  const auto offsets = calibration::estimate_payout_offsets(data->nominal, start_world, encoder_m);
+  ASSERT_TRUE(offsets) << offsets.error();
+  const calibration::PlannerOptions options = daemon::default_daemon_config().calibrator.planner;
+  const auto plan = calibration::plan_waypoints(data->nominal, *offsets, start_world, options);
+  ASSERT_TRUE(plan.ok()) << plan.problem;
+  ASSERT_EQ(static_cast<int>(plan.waypoints.size()), options.waypoint_count);
+
+  // THEN the virtual robot's true physics, driven through the waypoints in order, rests within 1 m of
+  // each planned pose
+  virtual_robot::PhysicsOptions physics_options;
+  physics_options.winch_speed_mps = 5.0;  // fewer equilibrium solves per move; same continuation
+  auto physics = virtual_robot::RobotPhysics::at_rest(truth, start_world, physics_options);
+  ASSERT_TRUE(physics) << physics.error();
+  for (std::size_t k = 0; k < plan.waypoints.size(); ++k) {
+    const calibration::Waypoint& waypoint = plan.waypoints[k];
+    for (int i = 0; i < kCableCount; ++i) physics->set_target(i, waypoint.payout_m[i]);
+    for (int step = 0; step < 20000 && !(physics->at_target(0) && physics->at_target(1) && physics->at_target(2) &&
+                                         physics->at_target(3));
+         ++step) {
+      physics->advance(0.01);
+    }
+    for (int step = 0; step < 300; ++step) physics->advance(0.01);  // settle: 15 time constants
+    const Eigen::Vector3d& planned = waypoint.rest.world_T_platform.position_world;
+    const double miss_m = (physics->pose().position_world - planned).norm();
+    EXPECT_LT(miss_m, 1.0) << "waypoint " << k << " planned at (" << planned.transpose() << "), arc lengths "
+                           << waypoint.rest.arc_length_m[0] << ", " << waypoint.rest.arc_length_m[1] << ", "
+                           << waypoint.rest.arc_length_m[2] << ", " << waypoint.rest.arc_length_m[3] << " m; "
+                           << physics->failed_solves() << " failed equilibrium solves so far";
+  }
+}
+
+}  // namespace
+}  // namespace cdpr::integration
