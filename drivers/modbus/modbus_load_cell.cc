@@ -94,7 +94,8 @@ hal::Status ModbusLoadCell::open() {
     return hal::Status(hal::ErrorCode::kInvalidArgument, "load cell: " + problem);
   }
   TcpEndpoint tcp;
-  if (parse_tcp(config_.endpoint.substr(4), tcp) && config_.endpoint.starts_with("tcp:")) {
+  tcp_ = parse_tcp(config_.endpoint.substr(4), tcp) && config_.endpoint.starts_with("tcp:");
+  if (tcp_) {
     context_ = modbus_new_tcp_pi(tcp.host.c_str(), tcp.port.c_str());
   } else {
     context_ = modbus_new_rtu(config_.endpoint.substr(4).c_str(), config_.baud, config_.parity, config_.data_bits,
@@ -169,10 +170,17 @@ hal::Result<hal::TensionSample> ModbusLoadCell::read() {
       }
       return hal::TensionSample{decoded.value().tension_n, decoded.value().stable, clock_.now_us()};
     }
-    // Drop a late reply so it is not taken for the next answer; a broken
-    // connection is rebuilt on the next try.
-    if (last.code() == hal::ErrorCode::kTimeout || last.code() == hal::ErrorCode::kCorruptData) modbus_flush(context_);
-    if (last.code() == hal::ErrorCode::kNotConnected || last.code() == hal::ErrorCode::kIoError) {
+    // A late reply must not be taken for the next answer. On a serial line
+    // flushing drops it. A TCP stream may deliver it after any flush, and
+    // then every later request would read its predecessor's reply (libmodbus
+    // refuses the transaction id: "Invalid data", forever); a new connection
+    // cannot carry it, so TCP reconnects. A broken connection is rebuilt on
+    // the next try as well.
+    const bool stale_reply_possible =
+        last.code() == hal::ErrorCode::kTimeout || last.code() == hal::ErrorCode::kCorruptData;
+    if (stale_reply_possible && !tcp_) modbus_flush(context_);
+    if ((stale_reply_possible && tcp_) || last.code() == hal::ErrorCode::kNotConnected ||
+        last.code() == hal::ErrorCode::kIoError) {
       modbus_close(context_);
       connected_ = false;
     }

@@ -78,6 +78,7 @@ class ModbusLoadCell final : public hal::LoadCell {
   const hal::Clock& clock_;
   modbus_t* context_ = nullptr;
   bool connected_ = false;
+  bool tcp_ = false;  // Modbus TCP (else RTU): how a late reply is got rid of
   Counters counters_;
 };
 

@@ -2,7 +2,7 @@
 // A Modbus TCP load cell for loopback tests: a real libmodbus server on
 // 127.0.0.1 at a free port chosen by the kernel, serving the register map of
 // drivers/modbus/tension_registers.h from a thread. It can be muted (reads
-// requests, never answers) to provoke timeouts. Bounded: stop() shuts the
+// requests, never answers) to provoke timeouts, or answer one request late. Bounded: stop() shuts the
 // client socket down, so the thread ends even while blocked in a receive.
 
 #include <modbus/modbus.h>
@@ -45,6 +45,8 @@ class FakeModbusLoadCell {
     }
   }
   void mute(bool muted) { muted_ = muted; }
+  // The next reply is sent this late (a busy device or a congested link).
+  void delay_next_reply(std::chrono::milliseconds delay) { next_reply_delay_ms_ = static_cast<int>(delay.count()); }
   // Closes the present client connection (the server then accepts anew).
   void drop_client() {
     const int client = client_.load();
@@ -81,6 +83,9 @@ class FakeModbusLoadCell {
         if (length == 0) continue;
         ++requests_;
         if (muted_) continue;
+        if (const int delay_ms = next_reply_delay_ms_.exchange(0); delay_ms > 0) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
+        }
         std::lock_guard<std::mutex> lock(mutex_);
         modbus_reply(context_, query, length, mapping_);
       }
@@ -98,6 +103,7 @@ class FakeModbusLoadCell {
   std::atomic<bool> muted_{false};
   std::atomic<bool> stopping_{false};
   std::atomic<int> requests_{0};
+  std::atomic<int> next_reply_delay_ms_{0};
   std::mutex mutex_;
   std::thread thread_;
 };

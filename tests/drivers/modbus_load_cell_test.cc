@@ -92,6 +92,32 @@ TEST(ModbusLoadCell, SilentServerTimesOutAfterRetries) {
   EXPECT_FLOAT_EQ(again.value().tension_n, 100.0f);
 }
 
+TEST(ModbusLoadCell, ALateReplyOverTcpIsNeverTakenForALaterAnswer) {
+  // GIVEN a cell whose next reply comes after the driver's 100 ms timeout
+  test::FakeModbusLoadCell server;
+  server.set(250.0f, true);
+  fakes::ManualClock clock;
+  ModbusLoadCellConfig config = config_for(server.port());
+  config.response_timeout_us = 100'000;
+  ModbusLoadCell cell(config, clock);
+  ASSERT_TRUE(cell.open().ok());
+  ASSERT_TRUE(cell.read().ok());
+  server.delay_next_reply(std::chrono::milliseconds(150));
+  // WHEN read, and read again a few times
+  const auto late = cell.read();
+  // THEN the read succeeds on a retry and every later read gets its own answer, not its predecessor's
+  ASSERT_TRUE(late.ok()) << late.status().to_string();
+  EXPECT_FLOAT_EQ(late.value().tension_n, 250.0f);
+  EXPECT_GE(cell.counters().timeouts, 1u);
+  for (int k = 0; k < 5; ++k) {
+    server.set(300.0f + static_cast<float>(k), true);
+    const auto sample = cell.read();
+    ASSERT_TRUE(sample.ok()) << "read " << k << ": " << sample.status().to_string();
+    EXPECT_FLOAT_EQ(sample.value().tension_n, 300.0f + static_cast<float>(k));
+  }
+  EXPECT_EQ(cell.counters().corrupt, 0u);
+}
+
 TEST(ModbusLoadCell, DeviceErrorBitAndNanAreDeviceFaults) {
   test::FakeModbusLoadCell server;
   fakes::ManualClock clock;
