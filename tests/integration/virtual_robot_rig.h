@@ -50,6 +50,20 @@ inline daemon::DaemonConfig fast_daemon_config(const std::string& dir, const vir
   return config;
 }
 
+// The small robot (4.4 kg platform, 12.5 m x 4.5 m footprint) needs its own
+// limits: the defaults suit the large one, and its reference cable carries
+// about 11 N at rest, below the large robot's 20 N minimum.
+inline void use_small_robot_limits(daemon::DaemonConfig& config) {
+  config.calibrator.monitor.min_tension_n = 2.0;
+  config.calibrator.monitor.max_tension_n = 300.0;
+  calibration::PlannerOptions& planner = config.calibrator.planner;
+  planner.min_tension_n = 2.0;
+  planner.max_tension_n = 300.0;
+  planner.margin_m = 1.5;
+  planner.z_min_m = 3.0;
+  planner.z_max_m = 18.0;
+}
+
 class VirtualRobotRig {
  public:
   explicit VirtualRobotRig(virtual_robot::VirtualRobotOptions options) {
@@ -63,6 +77,7 @@ class VirtualRobotRig {
     robot_thread = std::thread([this] { robot->run(stop_robot); });
 
     config = fast_daemon_config(dir, *robot);
+    if (options.preset == sim::Preset::kSmall) use_small_robot_limits(config);
     drivers::can::CanWinchBankConfig winch_config;
     for (const daemon::WinchNodes& w : config.winches.winches) {
       winch_config.winches.push_back({w.drive_node_id, w.encoder_node_id, w.encoder_m_per_count, w.drive_m_per_count});
