@@ -14,7 +14,7 @@ DEB_PACKAGES := build-essential cmake pkg-config libeigen3-dev libsuitesparse-de
 # Ceres is used by the benchmark comparison only, never linked into the daemon.
 BENCH_PACKAGES := libceres-dev
 
-.PHONY: all deps bench-deps configure test sanitize demo demo-daemon bench install clean
+.PHONY: all deps bench-deps configure test sanitize demo demo-offline bench install clean
 
 all: configure
 	cmake --build $(BUILD) -j $(JOBS)
@@ -40,13 +40,13 @@ sanitize: deps
 	cd $(BUILD)-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
 	  ctest --output-on-failure -j $(JOBS)
 
+# The daemon against the virtual robot over real sockets, button via calibctl.
 demo: all
 	./tools/demo.sh $(BUILD)
 
-# The daemon against the virtual robot over real sockets, button via calibctl.
-# Runs end to end but its fit is still refused (see tools/demo-daemon.sh).
-demo-daemon: all
-	./tools/demo-daemon.sh $(BUILD)
+# The offline pipeline only: cdpr-sim, cdpr-calib solve, compare with truth.
+demo-offline: all
+	./tools/demo-offline.sh $(BUILD)
 
 bench: bench-deps configure
 	cmake -S . -B $(BUILD) -DCDPR_BENCH=ON
