@@ -119,12 +119,6 @@ double chi_square_upper_tail(double x, int k) {
   return normal_upper_tail((std::cbrt(x / k) - (1.0 - s)) / std::sqrt(s));
 }
 
-double chi_square_upper_quantile(double p, int k) {
-  const double s = 2.0 / (9.0 * k);
-  const double root = 1.0 - s + normal_upper_quantile(p) * std::sqrt(s);
-  return k * root * root * root;
-}
-
 Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const DiagnosisOptions& options) {
   Diagnosis d;
   if (options.folds < 2 || static_cast<std::size_t>(options.folds) > samples.size()) {

@@ -70,9 +70,6 @@ struct Diagnosis {
 
 Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const DiagnosisOptions& options);
 
-// Upper quantile of the chi-square distribution with k degrees of freedom:
-// the x with P(X > x) = p (Wilson-Hilferty; a few percent at k = 1).
-double chi_square_upper_quantile(double p, int k);
 // P(X > x) for X ~ chi-square(k) (Wilson-Hilferty).
 double chi_square_upper_tail(double x, int k);
 
