@@ -6,6 +6,7 @@ BUILD      ?= build
 BUILD_TYPE ?= RelWithDebInfo
 JOBS       ?= $(shell nproc)
 PREFIX     ?= /usr/local
+comma      := ,
 
 # Debian packages the project needs; see README.md for why each is here.
 DEB_PACKAGES := build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev \
@@ -13,8 +14,14 @@ DEB_PACKAGES := build-essential cmake pkg-config libeigen3-dev libsuitesparse-de
                 libgtest-dev libgmock-dev libbenchmark-dev libgpiod-dev systemd
 # Ceres is used by the benchmark comparison only, never linked into the daemon.
 BENCH_PACKAGES := libceres-dev
+# clang and its runtimes (libFuzzer, ASan, UBSan) for make fuzz only.
+FUZZ_PACKAGES := clang libclang-rt-14-dev
 
-.PHONY: all deps bench-deps configure test sanitize demo demo-offline bench install clean
+FUZZ_BUILD   ?= $(BUILD)-fuzz
+FUZZ_SECONDS ?= 600
+FUZZ_TARGETS ?=
+
+.PHONY: all deps bench-deps configure test sanitize fuzz demo demo-offline bench install clean
 
 all: configure
 	cmake --build $(BUILD) -j $(JOBS)
@@ -39,6 +46,16 @@ sanitize: deps
 	cmake --build $(BUILD)-asan -j $(JOBS)
 	cd $(BUILD)-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
 	  ctest --output-on-failure -j $(JOBS)
+
+# Every libFuzzer target (tests/fuzz) for FUZZ_SECONDS each, one after the
+# other, from its seed corpus; prints execs, coverage and crashes per target.
+# FUZZ_TARGETS=robot_toml,... picks some. Fails when a fuzzer finds a crash.
+fuzz: deps
+	@./tools/install-deps.sh $(FUZZ_PACKAGES)
+	CC=clang CXX=clang++ cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE= "-DCMAKE_CXX_FLAGS=-O1 -g" \
+	  "-DCMAKE_C_FLAGS=-O1 -g" -DCDPR_WERROR=OFF -DCDPR_FUZZ=ON
+	cmake --build $(FUZZ_BUILD) -j $(JOBS) --target fuzzers
+	./tests/fuzz/run_fuzzers.sh $(FUZZ_BUILD) $(FUZZ_SECONDS) $(subst $(comma), ,$(FUZZ_TARGETS))
 
 # The daemon against the virtual robot over real sockets, button via calibctl.
 demo: all
