@@ -4,8 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
+#include <utility>
 
 #include "src/formats/nearest_name.h"
+#include "src/formats/toml_text_check.h"
 
 namespace cdpr::formats {
 namespace {
@@ -76,6 +79,8 @@ int missing_key_line(const toml::table& table, std::string_view path) {
 }  // namespace
 
 Expected<toml::table, FormatError> parse_toml_document(std::string_view text, const std::string& source) {
+  // Before toml++ sees it: some non-ASCII text makes toml++ 3.3.0 undefined.
+  if (std::optional<FormatError> unsafe = find_unsafe_non_ascii(text, source)) return Unexpected{std::move(*unsafe)};
   try {
     return toml::parse(text, source);
   } catch (const toml::parse_error& e) {
