@@ -1,6 +1,7 @@
 #include "src/daemon/control_server.h"
 
 #include <fcntl.h>
+#include <grp.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
@@ -8,7 +9,9 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
+#include <vector>
 
 #include "src/control/control_request.h"
 #include "src/control/control_response.h"
@@ -37,13 +40,29 @@ hal::Status remove_stale_socket(const std::string& path) {
   return hal::Status::Ok();
 }
 
+// The group id of `group`: a group name, or a number.
+hal::Result<gid_t> group_id(const std::string& path, const std::string& group) {
+  std::vector<char> buffer(16384);
+  struct group entry {};
+  struct group* found = nullptr;
+  if (getgrnam_r(group.c_str(), &entry, buffer.data(), buffer.size(), &found) == 0 && found != nullptr) {
+    return found->gr_gid;
+  }
+  if (group.size() <= 9 && group.find_first_not_of("0123456789") == std::string::npos) {
+    return static_cast<gid_t>(std::strtoul(group.c_str(), nullptr, 10));
+  }
+  return hal::Status(hal::ErrorCode::kInvalidArgument,
+                     "control socket " + path + ": group '" + group + "' does not exist");
+}
+
 }  // namespace
 
-ControlServer::Client::Client(int client_fd)
-    : fd(client_fd), lines(control::kMaxRequestBytes + 1 /* a "\r" before "\n" is allowed */) {}
+ControlServer::Client::Client(int client_fd, unsigned long long round)
+    : fd(client_fd), lines(control::kMaxRequestBytes + 1 /* a "\r" before "\n" is allowed */),
+      last_request_round(round) {}
 
 hal::Result<std::unique_ptr<ControlServer>> ControlServer::listen(const std::string& path, Handler handler,
-                                                                 unsigned mode) {
+                                                                 unsigned mode, const std::string& group) {
   sockaddr_un address{};
   address.sun_family = AF_UNIX;
   if (path.empty() || path.size() >= sizeof(address.sun_path)) {
@@ -52,6 +71,12 @@ hal::Result<std::unique_ptr<ControlServer>> ControlServer::listen(const std::str
                            std::to_string(sizeof(address.sun_path) - 1) + " bytes");
   }
   std::memcpy(address.sun_path, path.c_str(), path.size() + 1);
+  gid_t gid = static_cast<gid_t>(-1);  // -1: keep the daemon's group
+  if (!group.empty()) {
+    const hal::Result<gid_t> resolved = group_id(path, group);
+    if (!resolved.ok()) return resolved.status();
+    gid = resolved.value();
+  }
   if (hal::Status removed = remove_stale_socket(path); !removed.ok()) return removed;
 
   const int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
@@ -62,8 +87,18 @@ hal::Result<std::unique_ptr<ControlServer>> ControlServer::listen(const std::str
     return status;
   }
   // Clients are the robot's operators (group of the socket); nobody else.
-  if (chmod(path.c_str(), static_cast<mode_t>(mode)) != 0 || ::listen(fd, 16) != 0) {
-    hal::Status status = errno_status(path, "chmod/listen");
+  // The group is set before the mode opens the socket to it. The backlog
+  // holds a burst of simultaneous connects until the next service().
+  const char* failed = nullptr;
+  if (chown(path.c_str(), static_cast<uid_t>(-1), gid) != 0) {
+    failed = "chown (is the daemon's user a member of the group?)";
+  } else if (chmod(path.c_str(), static_cast<mode_t>(mode)) != 0) {
+    failed = "chmod";
+  } else if (::listen(fd, static_cast<int>(kMaxClients)) != 0) {
+    failed = "listen";
+  }
+  if (failed != nullptr) {
+    hal::Status status = errno_status(path, failed);
     close(fd);
     unlink(path.c_str());
     return status;
@@ -90,7 +125,14 @@ void ControlServer::append_poll_fds(std::vector<pollfd>& fds) const {
 }
 
 void ControlServer::service(const std::vector<pollfd>& fds) {
-  for (const pollfd& entry : fds) {
+  ++round_;
+  // Start at a rotating entry so that, when the request budget runs out,
+  // other clients are first next time.
+  std::size_t answered = 0;
+  const std::size_t count = fds.size();
+  const std::size_t first = count == 0 ? 0 : first_served_++ % count;
+  for (std::size_t k = 0; k < count; ++k) {
+    const pollfd& entry = fds[(first + k) % count];
     if (entry.revents == 0) continue;
     if (entry.fd == listen_fd_) {
       accept_clients();
@@ -100,7 +142,9 @@ void ControlServer::service(const std::vector<pollfd>& fds) {
                                  [&](const auto& client) { return client->fd == entry.fd; });
     if (it == clients_.end()) continue;
     Client& client = **it;
-    if (entry.revents & (POLLIN | POLLHUP | POLLERR)) read_from(client);
+    if ((entry.revents & (POLLIN | POLLHUP | POLLERR)) && answered < kMaxRequestsPerService) {
+      answered += read_from(client);
+    }
     if (!client.output.empty()) write_to(client);
   }
   std::erase_if(clients_, [](const auto& client) {
@@ -115,34 +159,43 @@ void ControlServer::accept_clients() {
   for (;;) {
     const int fd = accept4(listen_fd_, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
     if (fd < 0) return;  // EAGAIN (backlog empty) or a transient error: next poll
-    if (clients_.size() >= kMaxClients) {
-      const std::string busy = control::format_error_response("too many control clients; try again later");
-      [[maybe_unused]] const ssize_t ignored = send(fd, busy.data(), busy.size(), MSG_NOSIGNAL);
-      close(fd);
-      ++counters_.refused;
-      continue;
-    }
-    clients_.push_back(std::make_unique<Client>(fd));
+    if (clients_.size() >= kMaxClients) displace_stalest_client();
+    clients_.push_back(std::make_unique<Client>(fd, round_));
     ++counters_.accepted;
   }
 }
 
-void ControlServer::read_from(Client& client) {
+void ControlServer::displace_stalest_client() {
+  const auto stalest = std::min_element(clients_.begin(), clients_.end(), [](const auto& a, const auto& b) {
+    return a->last_request_round < b->last_request_round;
+  });
+  const std::string busy = control::format_error_response(
+      "too many control clients: closing this idle connection for a new one; reconnect to continue");
+  [[maybe_unused]] const ssize_t ignored = send((*stalest)->fd, busy.data(), busy.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+  close((*stalest)->fd);
+  clients_.erase(stalest);
+  ++counters_.displaced;
+}
+
+std::size_t ControlServer::read_from(Client& client) {
   char buffer[kReadChunkBytes];
   // One chunk per service call keeps a chatty client from starving the loop.
   const ssize_t got = recv(client.fd, buffer, sizeof(buffer), 0);
   if (got == 0) {
     client.read_closed = true;
-    return;
+    return 0;
   }
   if (got < 0) {
     if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) client.broken = true;
-    return;
+    return 0;
   }
+  std::size_t answered = 0;
   client.lines.feed(
       std::string_view(buffer, static_cast<std::size_t>(got)),
       [&](std::string_view line) {
         ++counters_.requests;
+        ++answered;
+        client.last_request_round = round_;
         client.output += handler_(line);
       },
       [&] {
@@ -153,6 +206,7 @@ void ControlServer::read_from(Client& client) {
     client.broken = true;
     ++counters_.dropped;
   }
+  return answered;
 }
 
 void ControlServer::write_to(Client& client) {

@@ -10,11 +10,22 @@
 // descriptors, then hands the results back (service). Everything is
 // non-blocking; a slow or dead client only costs its own connection.
 //
-// Bounds (a client can never make the daemon buffer without limit): requests
-// are cut by LineAssembler (an overlong line gets an error response and is
-// skipped), at most kMaxClients connections (one more is told so and closed),
-// at most kMaxPendingOutputBytes unsent response bytes per client (a client
-// that does not read is dropped).
+// Bounds (a client can never make the daemon buffer without limit, nor
+// stall its loop): requests are cut by LineAssembler (an overlong line gets
+// an error response and is skipped); at most kMaxClients connections: when
+// full, a new client displaces the one whose last complete request (or
+// connect) is oldest, which is told why and closed, so idle or slow-loris
+// connections cannot lock operators out; at most kMaxPendingOutputBytes
+// unsent response bytes per client (a client that does not read is dropped);
+// one service() call reads at most kReadChunkBytes per client and stops
+// reading once kMaxRequestsPerService requests were answered (the rest wait
+// in the kernel for the next call; the first client served rotates), so the
+// loop's time per call stays bounded however hard clients push.
+//
+// Access: the socket gets `mode` (0660: owner and group) and, when `group` is
+// given, that group (the daemon's user must be a member: SupplementaryGroups=
+// in the unit; no capability is needed for that chown). Without a group it
+// keeps the daemon's own group.
 //
 // Ownership: owns its listening and client sockets; the destructor closes
 // them and removes the socket path it created. Not thread-safe: one thread
@@ -36,20 +47,23 @@ namespace cdpr::daemon {
 
 class ControlServer {
  public:
-  static constexpr std::size_t kMaxClients = 32;
+  static constexpr std::size_t kMaxClients = 128;
   static constexpr std::size_t kMaxPendingOutputBytes = 1 << 20;
-  static constexpr std::size_t kReadChunkBytes = 4096;
+  static constexpr std::size_t kReadChunkBytes = 1024;
+  static constexpr std::size_t kMaxRequestsPerService = 256;
 
   // Answers one request line (without its "\n") with one response line
   // (with its "\n").
   using Handler = std::function<std::string(std::string_view request_line)>;
 
   // Binds and listens at `path` (a stale socket left by a crash is removed;
-  // any other file there is refused) and sets its mode to `mode`.
-  // Errors: kInvalidArgument (path too long, not a socket in the way),
-  // kIoError (socket, bind, listen, chmod), each naming the path and errno.
+  // any other file there is refused), sets its mode to `mode` and, when
+  // `group` (a name or a numeric id) is not empty, its group.
+  // Errors: kInvalidArgument (path too long, not a socket in the way, no
+  // such group), kIoError (socket, bind, listen, chmod, chown), each naming
+  // the path and errno.
   static hal::Result<std::unique_ptr<ControlServer>> listen(const std::string& path, Handler handler,
-                                                           unsigned mode = 0660);
+                                                           unsigned mode = 0660, const std::string& group = "");
   ~ControlServer();
   ControlServer(const ControlServer&) = delete;
   ControlServer& operator=(const ControlServer&) = delete;
@@ -68,7 +82,7 @@ class ControlServer {
   // Counters for diagnostics.
   struct Counters {
     unsigned long long accepted = 0;
-    unsigned long long refused = 0;  // over kMaxClients
+    unsigned long long displaced = 0;  // closed to make room for a new client (kMaxClients)
     unsigned long long requests = 0;
     unsigned long long dropped = 0;  // output over the limit or i/o error
   };
@@ -81,12 +95,16 @@ class ControlServer {
     std::string output;      // responses not yet written
     bool read_closed = false;  // peer sent EOF: close once output is flushed
     bool broken = false;       // close now
-    explicit Client(int client_fd);
+    unsigned long long last_request_round = 0;  // service() call of the last complete request or the connect
+    explicit Client(int client_fd, unsigned long long round);
   };
 
   ControlServer(int listen_fd, std::string path, Handler handler);
   void accept_clients();
-  void read_from(Client& client);
+  // Closes the client whose last request is oldest, telling it why.
+  void displace_stalest_client();
+  // Returns the number of requests answered.
+  std::size_t read_from(Client& client);
   void write_to(Client& client);
 
   int listen_fd_;
@@ -94,6 +112,8 @@ class ControlServer {
   Handler handler_;
   std::vector<std::unique_ptr<Client>> clients_;
   Counters counters_;
+  unsigned long long round_ = 0;   // service() calls so far: the clients' idea of age, no clock needed
+  std::size_t first_served_ = 0;   // rotates so that a busy call does not always favour the same clients
 };
 
 }  // namespace cdpr::daemon

@@ -1,11 +1,14 @@
 // The control socket server against a stub handler, through real Unix
 // sockets: ordering, many concurrent clients, bounds, permissions, cleanup.
 
+#include <grp.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -163,8 +166,9 @@ TEST(ControlServer, RefusesAnOverlongRequestAndKeepsServingTheClient) {
   close(client);
 }
 
-TEST(ControlServer, TurnsAwayClientsBeyondTheLimitWithAReason) {
-  // GIVEN the server full of clients
+TEST(ControlServer, WhenFullANewClientDisplacesTheStalestWithAReason) {
+  // GIVEN the server full of clients, all of which asked something except the
+  // first, which only connected (an idle or slow-loris connection)
   TempDir dir;
   StubHandler handler;
   auto server = ControlServer::listen(dir / "control", std::ref(handler));
@@ -172,16 +176,52 @@ TEST(ControlServer, TurnsAwayClientsBeyondTheLimitWithAReason) {
   std::vector<int> clients;
   for (std::size_t k = 0; k < ControlServer::kMaxClients; ++k) {
     clients.push_back(connect_to(dir / "control"));
+    if (k > 0) send_text(clients.back(), "stat");  // slow: the rest of the line comes later
     pump(*server.value(), 1);
   }
-  // WHEN one more connects
+  for (std::size_t k = 1; k < clients.size(); ++k) send_text(clients[k], "us\n");
+  pump(*server.value(), 3);
+  // WHEN one more connects and asks
   const int extra = connect_to(dir / "control");
+  send_text(extra, "status\n");
   pump(*server.value());
-  // THEN it is told why and closed, and the others stay connected
-  EXPECT_NE(drain(extra).find("too many control clients"), std::string::npos);
+  // THEN it is answered, the idle first client is told why and closed, the others stay
+  EXPECT_EQ(drain(extra), "{\"echo\":\"status\"}\n");
+  EXPECT_NE(drain(clients[0]).find("too many control clients"), std::string::npos);
   EXPECT_EQ(server.value()->client_count(), ControlServer::kMaxClients);
-  EXPECT_EQ(server.value()->counters().refused, 1u);
+  EXPECT_EQ(server.value()->counters().displaced, 1u);
+  send_text(clients[1], "status\n");
+  pump(*server.value());
+  EXPECT_NE(drain(clients[1]).find("{\"echo\":\"status\"}\n"), std::string::npos);
   close(extra);
+  for (const int fd : clients) close(fd);
+}
+
+TEST(ControlServer, OneServiceCallAnswersABoundedNumberOfRequests) {
+  // GIVEN 8 clients that each pipelined hundreds of requests at once
+  TempDir dir;
+  StubHandler handler;
+  auto server = ControlServer::listen(dir / "control", std::ref(handler));
+  ASSERT_TRUE(server.ok());
+  std::string flood;
+  while (flood.size() + 2 <= ControlServer::kReadChunkBytes) flood += "s\n";
+  std::vector<int> clients;
+  for (int k = 0; k < 8; ++k) clients.push_back(connect_to(dir / "control"));
+  pump(*server.value(), 2);
+  ASSERT_EQ(server.value()->client_count(), 8u);
+  for (const int fd : clients) send_text(fd, flood);
+  // WHEN the loop serves them once
+  std::vector<pollfd> fds;
+  server.value()->append_poll_fds(fds);
+  ASSERT_GT(poll(fds.data(), fds.size(), 1000), 0);
+  const int before = handler.calls;
+  server.value()->service(fds);
+  // THEN at most the budget plus one client's chunk was answered in that call
+  const int one_chunk = static_cast<int>(flood.size() / 2);
+  EXPECT_LE(handler.calls - before, static_cast<int>(ControlServer::kMaxRequestsPerService) + one_chunk);
+  // AND later calls answer everything, each client all of its requests
+  pump(*server.value(), 40);
+  EXPECT_EQ(handler.calls - before, 8 * one_chunk);
   for (const int fd : clients) close(fd);
 }
 
@@ -201,6 +241,49 @@ TEST(ControlServer, SocketHasMode0660AndIsRemovedOnDestruction) {
   }
   // WHEN it is destroyed THEN the path is gone
   EXPECT_FALSE(std::filesystem::exists(path));
+}
+
+// In a child: drops to user nobody with only group `gid`, connects, and
+// exits 0 when the outcome is `expect_connected` (else 1; 2 if it could not drop).
+int connect_as_nobody(const std::string& path, gid_t gid, bool expect_connected) {
+  const pid_t child = fork();
+  if (child == 0) {
+    if (setgroups(0, nullptr) != 0 || setgid(gid) != 0 || setuid(65534) != 0) _exit(2);
+    const int fd = connect_to(path);
+    const bool denied = fd < 0 && errno == EACCES;
+    _exit((expect_connected ? fd >= 0 : denied) ? 0 : 1);
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 3;
+}
+
+TEST(ControlServer, SocketBelongsToTheConfiguredGroupAndOnlyItsMembersConnect) {
+  // GIVEN a server whose socket is given to a group (as root: any group id;
+  // otherwise the test's own group, the only one it may give)
+  TempDir dir;
+  StubHandler handler;
+  const std::string path = dir / "control";
+  const bool root = geteuid() == 0;
+  const gid_t operators = root ? 4242 : getegid();
+  auto server = ControlServer::listen(path, std::ref(handler), 0660, std::to_string(operators));
+  ASSERT_TRUE(server.ok()) << server.status().to_string();
+  // THEN the socket is that group's, mode 0660
+  struct stat info {};
+  ASSERT_EQ(stat(path.c_str(), &info), 0);
+  EXPECT_EQ(info.st_gid, operators);
+  EXPECT_EQ(info.st_mode & 0777, 0660u);
+  // AND an unknown group name is refused with its name
+  auto unknown = ControlServer::listen(dir / "other", std::ref(handler), 0660, "no-such-group-cdpr");
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_EQ(unknown.status().code(), hal::ErrorCode::kInvalidArgument);
+  EXPECT_NE(unknown.status().message().find("no-such-group-cdpr"), std::string::npos);
+  if (!root) GTEST_SKIP() << "connecting as other users needs root";
+  // WHEN an unprivileged user in that group, and one outside it, connect
+  ASSERT_EQ(chmod(std::filesystem::path(path).parent_path().c_str(), 0755), 0);
+  // THEN the member gets in and the outsider is refused by the kernel
+  EXPECT_EQ(connect_as_nobody(path, operators, true), 0);
+  EXPECT_EQ(connect_as_nobody(path, operators + 1, false), 0);
 }
 
 TEST(ControlServer, ReplacesAStaleSocketButNeverAnotherFile) {
