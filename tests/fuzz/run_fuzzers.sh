@@ -36,7 +36,7 @@ for name in "${targets[@]}"; do
   status=$?
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
-  last=$(grep -E '^#[0-9]+ ' "$log" | tail -1)
+  last=$(grep -E '^#[0-9]+[[:space:]]' "$log" | tail -1)
   cov=$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<<"$last")
   ft=$(sed -n 's/.* ft: \([0-9]*\).*/\1/p' <<<"$last")
   corp=$(sed -n 's/.* corp: \([0-9]*\).*/\1/p' <<<"$last")
@@ -48,7 +48,7 @@ for name in "${targets[@]}"; do
   fi
   summary+=("$(printf '%-18s execs %-10s exec/s %-7s cov %-6s ft %-7s corpus %-6s %s' \
     "$name" "${execs:-?}" "${rate:-?}" "${cov:-?}" "${ft:-?}" "${corp:-?}" "$result")")
-  grep -E '^(stat::|#[0-9]+ +DONE)' "$log"
+  grep -E '^(stat::|#[0-9]+[[:space:]]+DONE)' "$log"
 done
 echo
 echo "fuzz summary (${seconds}s each):"
