@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 namespace cdpr {
 namespace {
@@ -185,22 +186,34 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
       if (scores[a].evaluated != scores[b].evaluated) return scores[a].evaluated;
       return scores[a].held_out_drop > scores[b].held_out_drop;
     });
-    for (std::size_t j : order) d.steps.back().candidates.push_back(scores[j]);
-    const std::size_t best = order.front();
-    if (!scores[best].significant) break;
-
-    std::vector<Effect> with = model;
-    with.push_back(scores[best].effect);
-    CalibrationResult fit = fit_all(robot, samples, options, with);
-    if (!fit.ok) {
-      report(options, "stop: " + model_text(with) + " cannot be fitted to all samples: " + fit.message);
-      break;
+    // The best significant candidate whose fit on all samples is physical.
+    std::optional<std::size_t> best;
+    CalibrationResult best_fit;
+    for (std::size_t j : order) {
+      if (!scores[j].significant) break;
+      std::vector<Effect> with = model;
+      with.push_back(scores[j].effect);
+      CalibrationResult fit = fit_all(robot, samples, options, with);
+      std::string why = fit.ok ? effect_domain_violation(fit.effects.back().effect, fit.effects.back().value,
+                                                         fit.effects.back().sigma)
+                               : "cannot be fitted to all samples: " + fit.message;
+      if (why.empty()) {
+        best = j;
+        best_fit = std::move(fit);
+        break;
+      }
+      scores[j].significant = false;
+      scores[j].failure = "rejected: " + why;
+      report(options, "  reject " + std::string(effect_model_name(scores[j].effect)) + ": " + why);
     }
-    model = with;
-    report(options, "add " + std::string(effect_model_name(scores[best].effect)) + ": held-out normalized rms " +
+    for (std::size_t j : order) d.steps.back().candidates.push_back(scores[j]);
+    if (!best) break;
+
+    model.push_back(scores[*best].effect);
+    report(options, "add " + std::string(effect_model_name(scores[*best].effect)) + ": held-out normalized rms " +
                         fixed(d.steps.back().held_out.normalized_rms(), 3) + " -> " +
-                        fixed(evaluations[best].normalized_rms(), 3));
-    d.steps.push_back({model, scores[best].effect, std::move(fit), std::move(evaluations[best]), {}});
+                        fixed(evaluations[*best].normalized_rms(), 3));
+    d.steps.push_back({model, scores[*best].effect, std::move(best_fit), std::move(evaluations[*best]), {}});
   }
 
   const HeldOutEvaluation& last = d.steps.back().held_out;

@@ -13,7 +13,9 @@
 // (Vuong's, for non-nested predictive likelihoods), mean(d) / (sd(d) / sqrt(n))
 // above the normal quantile at level alpha / m (Bonferroni over the m
 // candidates of the round). The spread of d is measured, not assumed, since
-// cross-validated drops vary more than a chi-square with k dof would.
+// cross-validated drops vary more than a chi-square with k dof would. A
+// significant candidate whose fit on all samples leaves its physical range
+// (solver/effects.h effect_domain_violation) is rejected, not added.
 // Pure numerics: progress goes through a callback.
 
 #include <functional>

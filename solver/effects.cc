@@ -50,6 +50,20 @@ std::string_view effect_description(Effect e) {
   return "?";
 }
 
+std::string effect_domain_violation(Effect e, const std::vector<double>& value, const std::vector<double>& sigma) {
+  const auto below_zero = [&](const char* what) -> std::string {
+    if (value.at(0) < -3.0 * sigma.at(0)) return std::string(what) + " below zero by more than 3 sigma";
+    return {};
+  };
+  switch (e) {
+    case Effect::kElasticity: return below_zero("compliance 1/EA");
+    case Effect::kPulleyRadius: return below_zero("pulley radius");
+    case Effect::kDensityError: return value.at(0) <= -1.0 ? "cable density not positive" : "";
+    case Effect::kLoadCell: return value.at(1) <= -1.0 ? "load-cell gain factor not positive" : "";
+    default: return {};
+  }
+}
+
 void add_effect_values(Effect e, const std::vector<double>& parameter, const std::vector<double>& parameter_sigma,
                        EffectValues& out) {
   const std::string name = effect_value_names(e).front();

@@ -61,6 +61,11 @@ std::string_view effect_description(Effect e);
 // under that name + "_sigma" (first order through the parameter's covariance).
 void add_effect_values(Effect e, const std::vector<double>& parameter, const std::vector<double>& parameter_sigma,
                        EffectValues& out);
+// Why a fitted parameter (solver units, with its 1-sigma) is physically
+// impossible, or empty: a compliance or pulley radius below zero by more than
+// 3 sigma, a density or load-cell gain factor (1 + r) <= 0. Such a fit means
+// the term is mimicking something else.
+std::string effect_domain_violation(Effect e, const std::vector<double>& value, const std::vector<double>& sigma);
 // The [effects] names of the effect's physical values, in add_effect_values order.
 std::vector<std::string> effect_value_names(Effect e);
 

@@ -13,6 +13,7 @@
 # truth (final fit on all samples), the held-out normalized rms ended within
 # 20 % of the noise floor (<= 1.2), the anchors improved against the plain
 # catenary fit of the same samples, and "structure remains" was said.
+# ONLY=REGEX limits the cases to those whose name matches.
 set -euo pipefail
 build=${1:-build}
 seeds=${2:-5}
@@ -29,6 +30,7 @@ field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<"$2"; }
 run_case() {
   local name=$1 expected=$2 first=$3 count=$4
   shift 4
+  [[ $name =~ ${ONLY:-.} ]] || return 0
   local named=0 within=0 floor=0 better=0 structure=0 fitted=0 runs=0
   local start_sum=0 final_sum=0 base_sum=0 anchor_sum=0
   for ((seed = first; seed < first + count; ++seed)); do

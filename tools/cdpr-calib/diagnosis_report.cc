@@ -136,6 +136,7 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
       } else {
         append(out, "    %-14s %10.1f  t %6.2f (threshold %.2f)%s\n", name.c_str(), cand.held_out_drop, cand.t_statistic,
                cand.threshold, cand.significant ? "  significant" : "");
+        if (!cand.failure.empty()) append(out, "      %s\n", cand.failure.c_str());
       }
     }
   }
