@@ -80,6 +80,8 @@ run_case "pulley radius 0.15 m" pulley_radius 11 "$seeds" --pulley-radius 0.15
 run_case "density error 5 %" density_error 11 "$seeds" --density-error 0.05
 run_case "none (false positives)" none 101 "$null_seeds"
 run_case "EA 1.5e6 N + bias 15 N" elasticity,load_cell 11 "$seeds" --axial-stiffness 1.5e6 --force-bias 15
+run_case "enc. scale 0.3 % + bias 15 N" encoder_scale,load_cell 11 "$seeds" --encoder-scale 0.003 --force-bias 15
+run_case "EA 1.5e6 N + CoM 5 cm" elasticity,com_offset 11 "$seeds" --axial-stiffness 1.5e6 --com-offset 0.03,0.04,0
 run_case "wind 36 N (unknown)" none 11 "$seeds" --wind 30,20,0
 run_case "wind 72 N (unknown)" none 11 "$seeds" --wind 60,40,0
 run_case "wind 117 N (unknown)" none 11 "$seeds" --wind 100,60,0
