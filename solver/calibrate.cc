@@ -1,5 +1,6 @@
 #include "solver/calibrate.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -52,71 +53,69 @@ struct PoseStart {
   std::array<double, kCableCount> lengths{};
 };
 
-std::optional<Eigen::Vector2d> start_force(const Robot& robot, const Anchors& anchors, const Sample& sample,
-                                           const CalibrationOptions& o) {
-  std::optional<Eigen::Vector2d> force = refine_reference_force(
-      robot, anchors, sample, paper_reference_force_guess(robot, anchors, sample), o.height_sigma_m);
-  if (!force) {
-    force = refine_reference_force(robot, anchors, sample, rigid_reference_force_guess(robot, anchors, sample),
-                                   o.height_sigma_m);
-  }
-  return force;
-}
-
 // The cables' lines of action pass close to the platform centre, so its
 // yaw balance is weak: with anchors metres off, the measured heading may
 // admit no tension-only equilibrium. The paper (Sec. IV-C) lets a rotation
 // variable absorb this; here the start turns the pose about the vertical by
-// the smallest angle that makes every cable pull, and the pose prior pulls it
-// back as the anchors converge.
+// the smallest angle at which a force guess refines to a plausible
+// equilibrium (every cable pulling, the reference tension within a few times
+// the larger of the platform's weight and the load cell's reading, no cable
+// much longer than its chord: near the edge of the feasible headings the
+// refinement can run off to absurd forces or sags); then force and heading
+// are refined together within a degree of that turn. The pose prior pulls the heading back as the anchors converge.
 PoseStart start_pose(const Robot& robot, const Anchors& anchors, const Sample& sample, const CalibrationOptions& o) {
   constexpr double kYawStepRad = 0.25 * M_PI / 180.0;
   constexpr int kYawSteps = 120;  // up to +-30 degrees
-  // Turns are tried outwards from the measured heading; the first start
-  // whose cable ends miss their attachments by less than this is taken,
-  // otherwise the best of the whole range.
-  constexpr double kGoodEnoughHeightMissM = 0.5;
-  PoseStart best;
-  double best_cost = std::numeric_limits<double>::infinity();
+  constexpr double kMaxTensionRatio = 4.0;
+  constexpr double kPolishRad = 1.0 * M_PI / 180.0;
+  constexpr double kMaxArcOverChord = 1.5;
+  const double max_tension =
+      kMaxTensionRatio * std::max(robot.platform_mass_kg * robot.gravity_mps2, sample.force_n);
+  PoseStart start;
+  auto take = [&](const Sample& turned, const Eigen::Vector2d& force) {
+    const Pose pose = measured_pose(turned);
+    const auto cables = predict_cables(robot, anchors, pose, force);
+    if (!cables) return false;
+    // The height fit alone also admits a cable hanging in a deep U whose
+    // lowest point is the attachment; no real pose looks like that.
+    for (int i = 0; i < kCableCount; ++i) {
+      const double chord = (pose.transform(robot.winches[i].attachment_platform) - anchors[i]).norm();
+      if (!((*cables)[i].arc_length_m <= kMaxArcOverChord * chord)) return false;
+    }
+    start.usable = true;
+    start.world_T_platform = pose;
+    start.reference_force = force;
+    for (int i = 0; i < kCableCount; ++i) start.lengths[i] = (*cables)[i].arc_length_m;
+    return true;
+  };
   for (int step = 0; step <= 2 * kYawSteps; ++step) {
     const double yaw = kYawStepRad * ((step + 1) / 2) * (step % 2 ? 1.0 : -1.0);
     Sample turned = sample;
     turned.world_R_platform = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())) * sample.world_R_platform;
-    const std::optional<Eigen::Vector2d> force = start_force(robot, anchors, turned, o);
-    if (!force) continue;
-    const Pose pose = measured_pose(turned);
-    const auto cables = predict_cables(robot, anchors, pose, *force);
-    if (!cables) continue;
-    double worst_miss = 0.0, cost = 0.0;
-    for (int i = 0; i < kCableCount; ++i) {
-      const double miss = (*cables)[i].end_height_m - pose.transform(robot.winches[i].attachment_platform).z();
-      worst_miss = std::max(worst_miss, std::abs(miss));
-      cost += std::pow(miss / o.height_sigma_m, 2);
-    }
-    cost += std::pow(((*cables)[robot.reference_cable].tension_n - sample.force_n) / robot.noise.force_n, 2);
-    if (!std::isfinite(cost) || cost >= best_cost) continue;
-    best_cost = cost;
-    best.usable = true;
-    best.world_T_platform = pose;
-    best.reference_force = *force;
-    for (int i = 0; i < kCableCount; ++i) best.lengths[i] = (*cables)[i].arc_length_m;
-    if (worst_miss < kGoodEnoughHeightMissM) break;  // the smallest turn that gives a good start
-  }
-  if (!best.usable) {
-    // Neither guess leads to an equilibrium at any heading: search the
-    // forces at the measured heading as a last resort.
-    const std::optional<Eigen::Vector2d> feasible = search_feasible_reference_force(robot, anchors, sample, o.height_sigma_m);
-    const std::optional<Eigen::Vector2d> force =
-        feasible ? refine_reference_force(robot, anchors, sample, *feasible, o.height_sigma_m) : std::nullopt;
-    const auto cables = force ? predict_cables(robot, anchors, measured_pose(sample), *force) : std::nullopt;
-    if (cables) {
-      best.usable = true;
-      best.world_T_platform = measured_pose(sample);
-      best.reference_force = *force;
-      for (int i = 0; i < kCableCount; ++i) best.lengths[i] = (*cables)[i].arc_length_m;
+    for (int guess = 0; guess < 2; ++guess) {
+      const Eigen::Vector2d initial = guess == 0 ? paper_reference_force_guess(robot, anchors, turned)
+                                                 : rigid_reference_force_guess(robot, anchors, turned);
+      const std::optional<Eigen::Vector2d> force =
+          refine_reference_force(robot, anchors, turned, initial, o.height_sigma_m);
+      if (!force || !(force->norm() <= max_tension)) continue;
+      const std::optional<ForceAndHeading> polished = refine_reference_force_and_heading(
+          robot, anchors, sample, *force, yaw, yaw - kPolishRad, yaw + kPolishRad, o.height_sigma_m);
+      if (polished && polished->reference_force.norm() <= max_tension) {
+        Sample polished_turn = sample;
+        polished_turn.world_R_platform =
+            Eigen::Quaterniond(Eigen::AngleAxisd(polished->yaw_rad, Eigen::Vector3d::UnitZ())) * sample.world_R_platform;
+        if (take(polished_turn, polished->reference_force)) return start;
+      }
+      if (take(turned, *force)) return start;
     }
   }
-  return best;
+  // Neither guess leads to a plausible equilibrium at any heading: search
+  // the forces at the measured heading as a last resort.
+  const std::optional<Eigen::Vector2d> feasible = search_feasible_reference_force(robot, anchors, sample, o.height_sigma_m);
+  const std::optional<Eigen::Vector2d> force =
+      feasible ? refine_reference_force(robot, anchors, sample, *feasible, o.height_sigma_m) : std::nullopt;
+  if (force) take(sample, *force);
+  return start;
 }
 
 std::array<double, kCableCount> straight_lengths(const Robot& robot, const Anchors& anchors, const Sample& sample) {

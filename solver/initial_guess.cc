@@ -1,9 +1,11 @@
 #include "solver/initial_guess.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "solver/static_pose_factor.h"
+#include "solver/catenary.h"
+#include "solver/platform_statics.h"
 
 namespace cdpr {
 
@@ -38,53 +40,84 @@ Eigen::Vector2d rigid_reference_force_guess(const Robot& robot, const std::array
   return {tension * std::hypot(u.x(), u.y()), tension * u.z()};
 }
 
+namespace {
+
+constexpr int kFitRows = kCableCount + 1;  // Eq. (15) per cable, Eq. (16)
+using FitResiduals = Eigen::Matrix<double, kFitRows, 1>;
+using FitJacobian = Eigen::Matrix<double, kFitRows, 2>;
+
+// The height (Eq. 15) and force (Eq. 16) residuals of StaticPoseFactor at
+// one pose, whitened, as functions of the reference force alone through the
+// statics' affine map, and (when `jacobian`) their derivatives. False where
+// a cable would push: outside the model.
+bool height_and_force(const Robot& robot, const ReferenceForceMap& map, const Sample& sample,
+                      const Eigen::Vector2d& force, double sigma_height_m, FitResiduals& residual,
+                      FitJacobian* jacobian) {
+  const double weight_per_length = robot.gravity_mps2 * robot.cable_linear_density_kgpm;
+  for (int i = 0; i < kCableCount; ++i) {
+    const Eigen::Vector2d f = map.offset[i] + map.gain[i] * force;
+    if (!(f.x() > 0.0)) return false;
+    const CatenaryOutput shape =
+        evaluate_catenary({f.x(), f.y(), map.span[i], map.anchor_z[i], weight_per_length}, jacobian != nullptr);
+    residual(i) = (map.attachment_z[i] - shape.end_height) / sigma_height_m;
+    if (jacobian) {
+      jacobian->row(i) =
+          -(shape.d_end_height(0) * map.gain[i].row(0) + shape.d_end_height(1) * map.gain[i].row(1)) / sigma_height_m;
+    }
+  }
+  const double tension = force.norm();
+  const double sigma_force = robot.noise.force_n;
+  residual(kCableCount) = (tension - sample.force_n) / sigma_force;
+  if (jacobian) {
+    jacobian->row(kCableCount).setZero();
+    if (tension > 0.0) jacobian->row(kCableCount) = force.transpose() / (tension * sigma_force);
+  }
+  return true;
+}
+
+std::optional<ReferenceForceMap> force_map(const Robot& robot, const std::array<Eigen::Vector3d, kCableCount>& anchors,
+                                           const Sample& sample) {
+  StaticsInput in;
+  in.world_T_platform = Pose{sample.position_world, sample.world_R_platform};
+  in.anchor_world = anchors;
+  ReferenceForceMap map;
+  if (reference_force_map(robot, in, map) != StaticsStatus::kOk) return std::nullopt;
+  return map;
+}
+
+}  // namespace
+
 std::optional<Eigen::Vector2d> refine_reference_force(const Robot& robot,
                                                       const std::array<Eigen::Vector3d, kCableCount>& anchors,
                                                       const Sample& sample, const Eigen::Vector2d& guess,
                                                       double sigma_height_m) {
-  const StaticPoseFactor factor(robot, 0, sample, sigma_height_m, Loss{});
-  constexpr int kRows = StaticPoseFactor::kResidualDim;
-  const double pose[7] = {sample.position_world.x(), sample.position_world.y(), sample.position_world.z(),
-                          sample.world_R_platform.w(), sample.world_R_platform.x(), sample.world_R_platform.y(),
-                          sample.world_R_platform.z()};
-  const double zero_offset[1] = {0.0};
-  Eigen::Vector2d force = guess;
-  const double* parameters[StaticPoseFactor::kKeyCount] = {pose, force.data()};
-  for (int i = 0; i < kCableCount; ++i) {
-    parameters[2 + i] = anchors[i].data();
-    parameters[2 + kCableCount + i] = zero_offset;
-  }
-  Eigen::Matrix<double, kRows, 1> residual;
-  Eigen::Matrix<double, kRows, 2, Eigen::RowMajor> d_force;
-  double* jacobians[StaticPoseFactor::kKeyCount] = {nullptr, d_force.data()};
-
   // Only the height and force rows constrain the force; encoder rows carry
-  // the still unknown offsets.
-  auto height_and_force_cost = [&](double* const* jac) -> std::optional<double> {
-    double cost = 0.0;
-    if (!factor.evaluate(parameters, residual.data(), jac, &cost)) return std::nullopt;
-    return residual.tail<kCableCount + 1>().squaredNorm();
-  };
-  std::optional<double> cost = height_and_force_cost(jacobians);
-  if (!cost) return std::nullopt;
+  // the still unknown offsets. The pose and anchors are fixed, so the
+  // statics are factorised once and each trial costs four catenaries.
+  const std::optional<ReferenceForceMap> map = force_map(robot, anchors, sample);
+  if (!map) return std::nullopt;
+  Eigen::Vector2d force = guess;
+  FitResiduals residual, trial_residual;
+  FitJacobian jacobian, trial_jacobian;
+  if (!height_and_force(robot, *map, sample, force, sigma_height_m, residual, &jacobian)) return std::nullopt;
+  double cost = residual.squaredNorm();
   double damping = 1e-3;
   for (int iteration = 0; iteration < 50 && damping < 1e12; ++iteration) {
-    const auto J = d_force.bottomRows<kCableCount + 1>();
-    const Eigen::Vector2d gradient = J.transpose() * residual.tail<kCableCount + 1>();
-    Eigen::Matrix2d H = J.transpose() * J;
+    const Eigen::Vector2d gradient = jacobian.transpose() * residual;
+    Eigen::Matrix2d H = jacobian.transpose() * jacobian;
     H.diagonal() *= 1.0 + damping;
-    const Eigen::Vector2d step = -H.ldlt().solve(gradient);
-    const Eigen::Vector2d previous = force;
-    force += step;
-    const std::optional<double> trial = height_and_force_cost(nullptr);
-    if (trial && *trial < *cost) {
-      const bool converged = *cost - *trial < 1e-12 * (1.0 + *cost);
-      cost = height_and_force_cost(jacobians);
+    const Eigen::Vector2d trial = force - H.ldlt().solve(gradient);
+    if (height_and_force(robot, *map, sample, trial, sigma_height_m, trial_residual, &trial_jacobian) &&
+        trial_residual.squaredNorm() < cost) {
+      const double trial_cost = trial_residual.squaredNorm();
+      const bool converged = cost - trial_cost < 1e-12 * (1.0 + cost);
+      force = trial;
+      residual = trial_residual;
+      jacobian = trial_jacobian;
+      cost = trial_cost;
       damping = std::max(damping / 10.0, 1e-9);
       if (converged) break;
     } else {
-      force = previous;
-      height_and_force_cost(jacobians);
       damping *= 10.0;
     }
   }
@@ -94,18 +127,9 @@ std::optional<Eigen::Vector2d> refine_reference_force(const Robot& robot,
 std::optional<Eigen::Vector2d> search_feasible_reference_force(const Robot& robot,
                                                                const std::array<Eigen::Vector3d, kCableCount>& anchors,
                                                                const Sample& sample, double sigma_height_m) {
-  const StaticPoseFactor factor(robot, 0, sample, sigma_height_m, Loss{});
-  const double pose[7] = {sample.position_world.x(), sample.position_world.y(), sample.position_world.z(),
-                          sample.world_R_platform.w(), sample.world_R_platform.x(), sample.world_R_platform.y(),
-                          sample.world_R_platform.z()};
-  const double zero_offset[1] = {0.0};
-  Eigen::Vector2d force;
-  const double* parameters[StaticPoseFactor::kKeyCount] = {pose, force.data()};
-  for (int i = 0; i < kCableCount; ++i) {
-    parameters[2 + i] = anchors[i].data();
-    parameters[2 + kCableCount + i] = zero_offset;
-  }
-  Eigen::Matrix<double, StaticPoseFactor::kResidualDim, 1> residual;
+  const std::optional<ReferenceForceMap> map = force_map(robot, anchors, sample);
+  if (!map) return std::nullopt;
+  FitResiduals residual;
   // A suspended platform's cables each carry at most a few times its weight.
   const double weight = robot.platform_mass_kg * robot.gravity_mps2;
   constexpr int kSteps = 60;
@@ -113,17 +137,88 @@ std::optional<Eigen::Vector2d> search_feasible_reference_force(const Robot& robo
   double best_cost = std::numeric_limits<double>::infinity();
   for (int a = 1; a <= kSteps; ++a) {
     for (int b = 0; b <= kSteps; ++b) {
-      force = Eigen::Vector2d(4.0 * weight * a / kSteps, weight * (-1.0 + 3.0 * b / kSteps));
-      double cost = 0.0;
-      if (!factor.evaluate(parameters, residual.data(), nullptr, &cost)) continue;
-      const double height_and_force = residual.tail<kCableCount + 1>().squaredNorm();
-      if (height_and_force < best_cost) {
-        best_cost = height_and_force;
+      const Eigen::Vector2d force(4.0 * weight * a / kSteps, weight * (-1.0 + 3.0 * b / kSteps));
+      if (!height_and_force(robot, *map, sample, force, sigma_height_m, residual, nullptr)) continue;
+      const double cost = residual.squaredNorm();
+      if (cost < best_cost) {
+        best_cost = cost;
         best = force;
       }
     }
   }
   return best;
+}
+
+std::optional<ForceAndHeading> refine_reference_force_and_heading(
+    const Robot& robot, const std::array<Eigen::Vector3d, kCableCount>& anchors, const Sample& sample,
+    const Eigen::Vector2d& guess, double yaw_guess_rad, double yaw_min_rad, double yaw_max_rad, double sigma_height_m) {
+  using Jacobian3 = Eigen::Matrix<double, kFitRows, 3>;
+  const double weight_per_length = robot.gravity_mps2 * robot.cable_linear_density_kgpm;
+  const double sigma_force = robot.noise.force_n;
+  // Residuals and their Jacobian in (f_h, f_v, yaw) at one point: the
+  // statics factorised at that heading, each catenary evaluated once.
+  auto evaluate = [&](const Eigen::Vector2d& force, double yaw, FitResiduals& residual, Jacobian3& jacobian) {
+    Sample turned = sample;
+    turned.world_R_platform = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())) * sample.world_R_platform;
+    const std::optional<ReferenceForceMap> map = force_map(robot, anchors, turned);
+    if (!map) return false;
+    std::array<Eigen::Vector2d, kCableCount> f;
+    for (int i = 0; i < kCableCount; ++i) {
+      f[i] = map->offset[i] + map->gain[i] * force;
+      if (!(f[i].x() > 0.0)) return false;
+    }
+    const std::array<Eigen::Vector2d, kCableCount> d_yaw = map->d_force_d_yaw(force);
+    for (int i = 0; i < kCableCount; ++i) {
+      const CatenaryOutput shape =
+          evaluate_catenary({f[i].x(), f[i].y(), map->span[i], map->anchor_z[i], weight_per_length}, true);
+      residual(i) = (map->attachment_z[i] - shape.end_height) / sigma_height_m;
+      jacobian.block<1, 2>(i, 0) =
+          -(shape.d_end_height(0) * map->gain[i].row(0) + shape.d_end_height(1) * map->gain[i].row(1)) / sigma_height_m;
+      jacobian(i, 2) = -(shape.d_end_height(0) * d_yaw[i].x() + shape.d_end_height(1) * d_yaw[i].y() +
+                         shape.d_end_height(2) * map->d_span_d_yaw[i]) /
+                       sigma_height_m;
+    }
+    const double tension = force.norm();
+    residual(kCableCount) = (tension - sample.force_n) / sigma_force;
+    jacobian.row(kCableCount).setZero();
+    if (tension > 0.0) jacobian.block<1, 2>(kCableCount, 0) = force.transpose() / (tension * sigma_force);
+    return true;
+  };
+  Eigen::Vector2d force = guess;
+  double yaw = std::clamp(yaw_guess_rad, yaw_min_rad, yaw_max_rad);
+  FitResiduals residual, trial_residual;
+  Jacobian3 jacobian, trial_jacobian;
+  if (!evaluate(force, yaw, residual, jacobian)) return std::nullopt;
+  double cost = residual.squaredNorm();
+  double damping = 1e-3;
+  for (int iteration = 0; iteration < 50 && damping < 1e12; ++iteration) {
+    const Eigen::Vector3d gradient = jacobian.transpose() * residual;
+    Eigen::Matrix3d H = jacobian.transpose() * jacobian;
+    H.diagonal() *= 1.0 + damping;
+    Eigen::Vector3d step = -H.ldlt().solve(gradient);
+    // At a bound the cost wants to cross, the heading stays there and the
+    // step is taken in the forces alone (a projected Gauss-Newton step).
+    if ((yaw <= yaw_min_rad && step(2) < 0.0) || (yaw >= yaw_max_rad && step(2) > 0.0)) {
+      step.head<2>() = -H.topLeftCorner<2, 2>().ldlt().solve(gradient.head<2>());
+      step(2) = 0.0;
+    }
+    const Eigen::Vector2d trial_force = force + step.head<2>();
+    const double trial_yaw = std::clamp(yaw + step(2), yaw_min_rad, yaw_max_rad);
+    if (evaluate(trial_force, trial_yaw, trial_residual, trial_jacobian) && trial_residual.squaredNorm() < cost) {
+      const double trial_cost = trial_residual.squaredNorm();
+      const bool converged = cost - trial_cost < 1e-12 * (1.0 + cost);
+      force = trial_force;
+      yaw = trial_yaw;
+      residual = trial_residual;
+      jacobian = trial_jacobian;
+      cost = trial_cost;
+      damping = std::max(damping / 10.0, 1e-9);
+      if (converged) break;
+    } else {
+      damping *= 10.0;
+    }
+  }
+  return ForceAndHeading{force, yaw};
 }
 
 std::array<double, kCableCount> mean_offsets(const std::vector<Sample>& samples,

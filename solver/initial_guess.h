@@ -41,6 +41,20 @@ std::optional<Eigen::Vector2d> refine_reference_force(const Robot& robot,
                                                       const Sample& sample, const Eigen::Vector2d& guess,
                                                       double sigma_height_m);
 
+// Refines the reference force and the heading together (anchors held
+// fixed): the same damped Gauss-Newton over (f_h, f_v, yaw), yaw a turn of
+// the measured pose about the world vertical through the platform origin,
+// kept in [yaw_min_rad, yaw_max_rad], starting from `guess` at
+// `yaw_guess_rad`. Every accepted point is evaluable (all cables pull).
+// Empty when the statics cannot be evaluated at the start.
+struct ForceAndHeading {
+  Eigen::Vector2d reference_force = Eigen::Vector2d::Zero();
+  double yaw_rad = 0.0;
+};
+std::optional<ForceAndHeading> refine_reference_force_and_heading(
+    const Robot& robot, const std::array<Eigen::Vector3d, kCableCount>& anchors, const Sample& sample,
+    const Eigen::Vector2d& guess, double yaw_guess_rad, double yaw_min_rad, double yaw_max_rad, double sigma_height_m);
+
 // Encoder offsets as the mean of (reading - modelled length) over the
 // samples; `lengths[k][i]` is the modelled length of cable i at sample k.
 std::array<double, kCableCount> mean_offsets(const std::vector<Sample>& samples,

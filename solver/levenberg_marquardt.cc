@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "solver/normal_equations.h"
+#include "solver/schur_complement.h"
 #include "solver/sparse_cholesky.h"
 
 namespace cdpr {
@@ -48,38 +49,122 @@ void symmetric_multiply(const NormalEquations& eq, const double* values, const d
   }
 }
 
+// The linear system of one linearisation, J^T J dx = -J^T r, as the loop
+// needs it: evaluate the factors into a slot, accumulate J^T J and J^T r,
+// factorise J^T J + D / radius (radius = infinity: J^T J itself), solve,
+// and dx' J^T J dx for the model decrease. None of it allocates.
+class LinearSystem {
+ public:
+  virtual ~LinearSystem() = default;
+  virtual LinearSystemKind kind() const = 0;
+  virtual int columns() const = 0;
+  virtual int variable_column(int v) const = 0;
+  virtual bool evaluate(const double* state, int slot, double* cost, int* failed_factor) = 0;
+  virtual void accumulate(int slot, double* gradient) = 0;
+  virtual FactorizationStatus factorize(double radius, std::string* message) = 0;
+  virtual void solve(const double* b, double* x) = 0;
+  virtual double quadratic(const double* x) = 0;
+};
+
+// The whole J^T J in CHOLMOD, AMD-ordered: any problem.
+class FullSystem final : public LinearSystem {
+ public:
+  explicit FullSystem(const Problem& problem)
+      : equations_(problem),
+        jtj_(equations_.nonzeros()),
+        damped_(equations_.nonzeros()),
+        product_(equations_.columns()) {
+    if (equations_.columns() > 0) {
+      cholesky_ = std::make_unique<SparseCholesky>(equations_.columns(), equations_.column_starts(),
+                                                   equations_.row_indices());
+    }
+  }
+  LinearSystemKind kind() const override { return LinearSystemKind::kFull; }
+  int columns() const override { return equations_.columns(); }
+  int variable_column(int v) const override { return equations_.variable_column(v); }
+  bool evaluate(const double* state, int slot, double* cost, int* failed_factor) override {
+    return equations_.evaluate(state, slot, cost, failed_factor);
+  }
+  void accumulate(int slot, double* gradient) override { equations_.accumulate(slot, jtj_.data(), gradient); }
+  FactorizationStatus factorize(double radius, std::string* message) override {
+    std::copy(jtj_.begin(), jtj_.end(), damped_.begin());
+    for (int c = 0; c < equations_.columns(); ++c) {
+      const int d = equations_.diagonal(c);
+      damped_[d] += std::clamp(jtj_[d], kMinDiagonal, kMaxDiagonal) / radius;
+    }
+    return cholesky_->factorize(damped_.data(), message);
+  }
+  void solve(const double* b, double* x) override { cholesky_->solve(b, x); }
+  double quadratic(const double* x) override {
+    symmetric_multiply(equations_, jtj_.data(), x, product_.data());
+    double sum = 0.0;
+    for (int c = 0; c < equations_.columns(); ++c) sum += x[c] * product_[c];
+    return sum;
+  }
+
+ private:
+  NormalEquations equations_;
+  std::unique_ptr<SparseCholesky> cholesky_;
+  std::vector<double> jtj_, damped_, product_;
+};
+
+// Per-pose blocks eliminated first, CHOLMOD on the reduced system over the
+// global variables (solver/schur_complement.h): calibration problems.
+class ReducedSystem final : public LinearSystem {
+ public:
+  explicit ReducedSystem(std::unique_ptr<SchurComplement> schur) : schur_(std::move(schur)) {}
+  LinearSystemKind kind() const override { return LinearSystemKind::kPosesEliminated; }
+  int columns() const override { return schur_->columns(); }
+  int variable_column(int v) const override { return schur_->variable_column(v); }
+  bool evaluate(const double* state, int slot, double* cost, int* failed_factor) override {
+    return schur_->linearization().evaluate(state, slot, cost, failed_factor);
+  }
+  void accumulate(int slot, double* gradient) override { schur_->accumulate(slot, gradient); }
+  FactorizationStatus factorize(double radius, std::string* message) override {
+    return schur_->factorize(radius, kMinDiagonal, kMaxDiagonal, message);
+  }
+  void solve(const double* b, double* x) override { schur_->solve(b, x); }
+  double quadratic(const double* x) override { return schur_->quadratic(x); }
+
+ private:
+  std::unique_ptr<SchurComplement> schur_;
+};
+
+// The system for a problem: reduced when its structure allows, else the
+// whole J^T J (with no columns when every variable is constant).
+std::unique_ptr<LinearSystem> make_system(const Problem& problem, bool eliminate_poses) {
+  if (std::unique_ptr<SchurComplement> schur = eliminate_poses ? SchurComplement::create(problem) : nullptr) {
+    return std::make_unique<ReducedSystem>(std::move(schur));
+  }
+  return std::make_unique<FullSystem>(problem);
+}
+
 }  // namespace
 
 struct LevenbergMarquardt::Impl {
   Problem& problem;
   SolverOptions options;
-  NormalEquations equations;
-  std::unique_ptr<SparseCholesky> cholesky;  // null when every variable is constant
-  std::vector<double> jtj, damped, gradient, step, jtj_step, candidate;
+  std::unique_ptr<LinearSystem> system;
+  std::vector<double> gradient, step, rhs, candidate;
   int slot = 0;  // linearisation slot of the current point
 
   Impl(Problem& p, SolverOptions o)
-      : problem(p),
-        options(std::move(o)),
-        equations(p),
-        jtj(equations.nonzeros()),
-        damped(equations.nonzeros()),
-        gradient(equations.columns()),
-        step(equations.columns()),
-        jtj_step(equations.columns()),
-        candidate(p.state().size()) {
-    if (equations.columns() > 0) {
-      cholesky = std::make_unique<SparseCholesky>(equations.columns(), equations.column_starts(),
-                                                  equations.row_indices());
-    }
+      : problem(p), options(std::move(o)), system(make_system(p, options.eliminate_poses)) {
+    const int n = system->columns();
+    gradient.assign(n, 0.0);
+    step.assign(n, 0.0);
+    rhs.assign(n, 0.0);
+    candidate.assign(p.state().size(), 0.0);
   }
+
+  int variable_column(int v) const { return system->variable_column(v); }
 
   // Norm of the ambient values of the non-constant variables (Ceres' |x|).
   double free_state_norm() const {
     double s = 0.0;
     const auto& variables = problem.variables();
     for (std::size_t v = 0; v < variables.size(); ++v) {
-      if (equations.variable_column(static_cast<int>(v)) < 0) continue;
+      if (variable_column(static_cast<int>(v)) < 0) continue;
       for (int i = 0; i < variables[v].ambient_dim; ++i) {
         const double x = problem.state()[variables[v].ambient_offset + i];
         s += x * x;
@@ -88,20 +173,12 @@ struct LevenbergMarquardt::Impl {
     return std::sqrt(s);
   }
 
-  void damp(double radius) {
-    std::copy(jtj.begin(), jtj.end(), damped.begin());
-    for (int c = 0; c < equations.columns(); ++c) {
-      const int d = equations.diagonal(c);
-      damped[d] += std::clamp(jtj[d], kMinDiagonal, kMaxDiagonal) / radius;
-    }
-  }
-
   // candidate = state boxplus step
   void make_candidate() {
     std::copy(problem.state().begin(), problem.state().end(), candidate.begin());
     const auto& variables = problem.variables();
     for (std::size_t v = 0; v < variables.size(); ++v) {
-      const int column = equations.variable_column(static_cast<int>(v));
+      const int column = variable_column(static_cast<int>(v));
       if (column >= 0) problem.retract(static_cast<int>(v), step.data() + column, candidate.data());
     }
   }
@@ -115,7 +192,7 @@ SolverSummary LevenbergMarquardt::Impl::solve() {
 
   int failed = -1;
   double cost = 0.0;
-  if (!equations.evaluate(problem.state().data(), slot, &cost, &failed)) {
+  if (!system->evaluate(problem.state().data(), slot, &cost, &failed)) {
     summary.termination = TerminationType::kNotEvaluable;
     const auto keys = problem.factors()[failed]->keys();
     summary.message = "factor " + std::to_string(failed) + " (first variable " +
@@ -123,7 +200,7 @@ SolverSummary LevenbergMarquardt::Impl::solve() {
                       ") cannot be evaluated at the initial point";
     return summary;
   }
-  equations.accumulate(slot, jtj.data(), gradient.data());
+  system->accumulate(slot, gradient.data());
   summary.initial_cost = summary.final_cost = cost;
 
   IterationSummary it;
@@ -137,7 +214,7 @@ SolverSummary LevenbergMarquardt::Impl::solve() {
   // composed after the loop from these numbers.
   enum class Stop { kNone, kGradient, kFunction, kParameter, kCollapsed, kFatal, kNoVariables };
   Stop stop = Stop::kNone;
-  if (!cholesky) stop = Stop::kNoVariables;
+  if (system->columns() == 0) stop = Stop::kNoVariables;
   else if (it.gradient_max_norm <= options.gradient_tolerance) stop = Stop::kGradient;
   double radius = options.initial_trust_radius;
   double nu = 2.0;
@@ -148,16 +225,15 @@ SolverSummary LevenbergMarquardt::Impl::solve() {
     it = IterationSummary{};
     it.iteration = iteration;
 
-    damp(radius);
-    const FactorizationStatus status = cholesky->factorize(damped.data(), nullptr);
+    const FactorizationStatus status = system->factorize(radius, nullptr);
     if (status == FactorizationStatus::kFatal) {
       stop = Stop::kFatal;
       break;
     }
     bool accepted = false;
     if (status == FactorizationStatus::kSuccess) {
-      for (int c = 0; c < equations.columns(); ++c) jtj_step[c] = -gradient[c];
-      cholesky->solve(jtj_step.data(), step.data());
+      for (int c = 0; c < system->columns(); ++c) rhs[c] = -gradient[c];
+      system->solve(rhs.data(), step.data());
       it.step_norm = norm(step);
       const double x_norm = free_state_norm();
       if (it.step_norm <= (x_norm + options.parameter_tolerance) * options.parameter_tolerance) {
@@ -165,24 +241,21 @@ SolverSummary LevenbergMarquardt::Impl::solve() {
         last_step_norm = it.step_norm;
       } else {
         // Predicted decrease of the undamped model: -(g.dx + 0.5 dx.JtJ.dx).
-        symmetric_multiply(equations, jtj.data(), step.data(), jtj_step.data());
-        double g_dx = 0.0, dx_jtj_dx = 0.0;
-        for (int c = 0; c < equations.columns(); ++c) {
-          g_dx += gradient[c] * step[c];
-          dx_jtj_dx += step[c] * jtj_step[c];
-        }
+        double g_dx = 0.0;
+        for (int c = 0; c < system->columns(); ++c) g_dx += gradient[c] * step[c];
+        const double dx_jtj_dx = system->quadratic(step.data());
         const double predicted = -(g_dx + 0.5 * dx_jtj_dx);
         make_candidate();
         const int other = 1 - slot;
         double new_cost = 0.0;
-        if (predicted > 0.0 && equations.evaluate(candidate.data(), other, &new_cost, &failed)) {
+        if (predicted > 0.0 && system->evaluate(candidate.data(), other, &new_cost, &failed)) {
           const double actual = cost - new_cost;
           const double rho = actual / predicted;
           if (rho > kMinRelativeDecrease) {
             accepted = true;
             std::copy(candidate.begin(), candidate.end(), problem.state().begin());
             slot = other;
-            equations.accumulate(slot, jtj.data(), gradient.data());
+            system->accumulate(slot, gradient.data());
             last_relative_decrease = std::abs(actual) / cost;
             it.cost_change = actual;
             cost = new_cost;
@@ -244,7 +317,7 @@ SolverSummary LevenbergMarquardt::Impl::solve() {
     case Stop::kFatal: {
       summary.termination = TerminationType::kLinearSolverFailure;
       std::string why;
-      (void)cholesky->factorize(damped.data(), &why);
+      (void)system->factorize(radius, &why);
       summary.message = "linear solver failed: " + why;
       return summary;
     }
@@ -260,28 +333,32 @@ LevenbergMarquardt::~LevenbergMarquardt() = default;
 
 SolverSummary LevenbergMarquardt::solve() { return impl_->solve(); }
 
+LinearSystemKind LevenbergMarquardt::linear_system() const { return impl_->system->kind(); }
+
 Eigen::MatrixXd LevenbergMarquardt::covariance(const std::vector<Key>& keys) {
   Impl& s = *impl_;
   std::vector<int> columns;  // tangent columns of the requested variables, in order
   for (const Key& key : keys) {
     if (!s.problem.has(key)) die("covariance of unknown variable " + to_string(key));
     const int v = s.problem.variable_index(key);
-    const int first = s.equations.variable_column(v);
+    const int first = s.variable_column(v);
     if (first < 0) die("covariance of constant variable " + to_string(key));
     for (int d = 0; d < s.problem.variables()[v].tangent_dim; ++d) columns.push_back(first + d);
   }
   int failed = -1;
   double cost = 0.0;
-  if (!s.cholesky || !s.equations.evaluate(s.problem.state().data(), s.slot, &cost, &failed)) return {};
-  s.equations.accumulate(s.slot, s.jtj.data(), s.gradient.data());
-  if (s.cholesky->factorize(s.jtj.data(), nullptr) != FactorizationStatus::kSuccess) return {};
+  if (s.system->columns() == 0 || !s.system->evaluate(s.problem.state().data(), s.slot, &cost, &failed)) return {};
+  s.system->accumulate(s.slot, s.gradient.data());
+  if (s.system->factorize(std::numeric_limits<double>::infinity(), nullptr) != FactorizationStatus::kSuccess) {
+    return {};
+  }
 
   const int n = static_cast<int>(columns.size());
   Eigen::MatrixXd result(n, n);
-  std::vector<double> unit(s.equations.columns(), 0.0), x(s.equations.columns());
+  std::vector<double> unit(s.system->columns(), 0.0), x(s.system->columns());
   for (int j = 0; j < n; ++j) {
     unit[columns[j]] = 1.0;
-    s.cholesky->solve(unit.data(), x.data());
+    s.system->solve(unit.data(), x.data());
     unit[columns[j]] = 0.0;
     for (int i = 0; i < n; ++i) result(i, j) = x[columns[i]];
   }

@@ -13,177 +13,144 @@ bool is_per_pose(const Key& key) {
   return key.kind == VariableKind::kPose || key.kind == VariableKind::kReferenceForce;
 }
 
-bool all_finite(const double* v, int n) {
-  for (int i = 0; i < n; ++i) {
-    if (!std::isfinite(v[i])) return false;
+std::vector<int> per_pose_first_columns(const Problem& problem, int* columns) {
+  const auto& variables = problem.variables();
+  const int nv = static_cast<int>(variables.size());
+  std::vector<int> variable_column(nv, -1);
+  *columns = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int v = 0; v < nv; ++v) {
+      if (variables[v].constant || is_per_pose(variables[v].key) != (pass == 0)) continue;
+      variable_column[v] = *columns;
+      *columns += variables[v].tangent_dim;
+    }
   }
-  return true;
+  return variable_column;
 }
 
 }  // namespace
 
-NormalEquations::NormalEquations(const Problem& problem) : problem_(problem) {
+NormalEquations::NormalEquations(const Problem& problem)
+    : linearization_(problem, per_pose_first_columns(problem, &columns_)) {
   const auto& variables = problem.variables();
-  const auto& factors = problem.factors();
   const int nv = static_cast<int>(variables.size());
-
-  // Column layout.
-  variable_column_.assign(nv, -1);
-  for (int pass = 0; pass < 2; ++pass) {
-    for (int v = 0; v < nv; ++v) {
-      if (variables[v].constant || is_per_pose(variables[v].key) != (pass == 0)) continue;
-      variable_column_[v] = columns_;
-      columns_ += variables[v].tangent_dim;
-    }
-  }
+  const int nf = linearization_.factor_count();
+  auto column_of = [&](int v) { return linearization_.variable_column(v); };
 
   // Block rows of each block column (indexed by the column's variable),
   // upper triangle: a row variable's first column <= the column variable's.
   std::vector<std::vector<int>> block_rows(nv);
   for (int v = 0; v < nv; ++v) {
-    if (variable_column_[v] >= 0) block_rows[v].push_back(v);
+    if (column_of(v) >= 0) block_rows[v].push_back(v);
   }
-  for (const auto& factor : factors) {
-    const std::span<const Key> keys = factor->keys();
-    for (const Key& a : keys) {
-      for (const Key& b : keys) {
-        const int va = problem.variable_index(a), vb = problem.variable_index(b);
-        if (variable_column_[va] < 0 || variable_column_[vb] < 0) continue;
-        if (variable_column_[va] < variable_column_[vb]) block_rows[vb].push_back(va);
+  for (int f = 0; f < nf; ++f) {
+    const int nk = linearization_.key_count(f);
+    for (int a = 0; a < nk; ++a) {
+      const int va = linearization_.key_variable(f, a);
+      if (column_of(va) < 0) continue;
+      for (int b = 0; b < nk; ++b) {
+        const int vb = linearization_.key_variable(f, b);
+        if (column_of(vb) >= 0 && column_of(va) < column_of(vb)) block_rows[vb].push_back(va);
       }
     }
   }
   for (auto& rows : block_rows) {
-    std::sort(rows.begin(), rows.end(),
-              [&](int x, int y) { return variable_column_[x] < variable_column_[y]; });
+    std::sort(rows.begin(), rows.end(), [&](int x, int y) { return column_of(x) < column_of(y); });
     rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
   }
 
   // Scalar pattern, column by column; the diagonal block comes last in each
   // of its columns and is cut at the diagonal.
   std::vector<int> column_variable(columns_);
+  std::size_t nonzeros = 0;
   for (int v = 0; v < nv; ++v) {
-    for (int d = 0; d < variables[v].tangent_dim && variable_column_[v] >= 0; ++d) {
-      column_variable[variable_column_[v] + d] = v;
+    for (int d = 0; d < variables[v].tangent_dim && column_of(v) >= 0; ++d) {
+      column_variable[column_of(v) + d] = v;
+      for (int r : block_rows[v]) nonzeros += r == v ? d + 1 : variables[r].tangent_dim;
     }
   }
+  row_indices_.reserve(nonzeros);
   column_starts_.assign(columns_ + 1, 0);
   for (int c = 0; c < columns_; ++c) {
     const int v = column_variable[c];
     for (int r : block_rows[v]) {
-      const int first = variable_column_[r];
+      const int first = column_of(r);
       const int last = r == v ? c : first + variables[r].tangent_dim - 1;
       for (int row = first; row <= last; ++row) row_indices_.push_back(row);
     }
     column_starts_[c + 1] = static_cast<int>(row_indices_.size());
   }
-  auto within = [&](int row_variable, int column_variable_index) {
-    int offset = 0;
-    for (int r : block_rows[column_variable_index]) {
-      if (r == row_variable) return offset;
-      offset += variables[r].tangent_dim;
-    }
-    return -1;  // unreachable: every pair was inserted above
-  };
 
-  // Per-factor layout, block references and scratch.
-  int residual_total = 0, jacobian_total = 0;
-  std::vector<int> jacobian_offset;  // per factor key into a slot's Jacobians, -1 if constant
-  for (const auto& factor : factors) {
-    const std::span<const Key> keys = factor->keys();
-    const int m = factor->residual_dim();
-    FactorLayout f;
-    f.residual_offset = residual_total;
-    f.key_offset = static_cast<int>(key_variable_.size());
-    f.block_begin = static_cast<int>(blocks_.size());
-    for (const Key& key : keys) {
-      const int v = problem.variable_index(key);
-      key_variable_.push_back(v);
-      key_column_.push_back(variable_column_[v]);
-      key_dim_.push_back(variables[v].tangent_dim);
-      jacobian_offset.push_back(variable_column_[v] >= 0 ? jacobian_total : -1);
-      if (variable_column_[v] >= 0) jacobian_total += m * variables[v].tangent_dim;
-    }
-    const int nk = static_cast<int>(keys.size());
+  // Per-factor block references: each pair of non-constant keys, oriented so
+  // the row variable comes first in column order. Where its rows start in
+  // the column variable's columns (`within`) is resolved per column
+  // variable, so the whole pass is linear in the number of blocks.
+  block_begin_.reserve(nf + 1);
+  std::vector<int> bucket_start(nv + 1, 0);  // blocks per column variable, then prefix sums
+  for (int f = 0; f < nf; ++f) {
+    block_begin_.push_back(static_cast<int>(blocks_.size()));
+    const int nk = linearization_.key_count(f);
     for (int a = 0; a < nk; ++a) {
       for (int b = a; b < nk; ++b) {
         int ka = a, kb = b;
-        const int va = key_variable_[f.key_offset + ka], vb = key_variable_[f.key_offset + kb];
-        if (variable_column_[va] < 0 || variable_column_[vb] < 0) continue;
-        if (variable_column_[va] > variable_column_[vb]) std::swap(ka, kb);
-        const int row_v = key_variable_[f.key_offset + ka], col_v = key_variable_[f.key_offset + kb];
-        blocks_.push_back({ka, kb, within(row_v, col_v)});
+        const int va = linearization_.key_variable(f, ka), vb = linearization_.key_variable(f, kb);
+        if (column_of(va) < 0 || column_of(vb) < 0) continue;
+        if (column_of(va) > column_of(vb)) std::swap(ka, kb);
+        blocks_.push_back({ka, kb, -1});
+        ++bucket_start[linearization_.key_variable(f, kb) + 1];
       }
     }
-    f.block_end = static_cast<int>(blocks_.size());
-    layout_.push_back(f);
-    residual_total += m;
   }
-  parameters_.assign(key_variable_.size(), nullptr);
-  for (int s = 0; s < kSlots; ++s) {
-    residuals_[s].assign(residual_total, 0.0);
-    jacobians_[s].assign(jacobian_total, 0.0);
-    jacobian_pointers_[s].assign(key_variable_.size(), nullptr);
-    for (std::size_t k = 0; k < key_variable_.size(); ++k) {
-      if (jacobian_offset[k] >= 0) jacobian_pointers_[s][k] = jacobians_[s].data() + jacobian_offset[k];
+  block_begin_.push_back(static_cast<int>(blocks_.size()));
+  for (int v = 0; v < nv; ++v) bucket_start[v + 1] += bucket_start[v];
+  std::vector<int> bucket(blocks_.size());  // (factor, block) pairs grouped by column variable
+  std::vector<int> block_factor(blocks_.size());
+  {
+    std::vector<int> next(bucket_start.begin(), bucket_start.end() - 1);
+    for (int f = 0; f < nf; ++f) {
+      for (int b = block_begin_[f]; b < block_begin_[f + 1]; ++b) {
+        block_factor[b] = f;
+        bucket[next[linearization_.key_variable(f, blocks_[b].column_key)]++] = b;
+      }
     }
   }
-}
-
-bool NormalEquations::evaluate(const double* state, int slot, double* cost, int* failed_factor) {
-  const auto& variables = problem_.variables();
-  const auto& factors = problem_.factors();
-  for (std::size_t k = 0; k < key_variable_.size(); ++k) {
-    parameters_[k] = state + variables[key_variable_[k]].ambient_offset;
-  }
-  double total = 0.0;
-  for (std::size_t fi = 0; fi < factors.size(); ++fi) {
-    const FactorLayout& f = layout_[fi];
-    const int m = factors[fi]->residual_dim();
-    double* residual = residuals_[slot].data() + f.residual_offset;
-    double* const* jacobians = jacobian_pointers_[slot].data() + f.key_offset;
-    double factor_cost = 0.0;
-    bool ok = factors[fi]->evaluate(parameters_.data() + f.key_offset, residual, jacobians, &factor_cost) &&
-              std::isfinite(factor_cost) && all_finite(residual, m);
-    const int nk = static_cast<int>(factors[fi]->keys().size());
-    for (int k = 0; ok && k < nk; ++k) {
-      if (jacobians[k] != nullptr) ok = all_finite(jacobians[k], m * key_dim_[f.key_offset + k]);
+  std::vector<int> row_offset(nv, -1);  // within the current column variable's columns
+  for (int v = 0; v < nv; ++v) {
+    int offset = 0;
+    for (int r : block_rows[v]) {
+      row_offset[r] = offset;
+      offset += variables[r].tangent_dim;
     }
-    if (!ok) {
-      *failed_factor = static_cast<int>(fi);
-      return false;
+    for (int i = bucket_start[v]; i < bucket_start[v + 1]; ++i) {
+      BlockRef& block = blocks_[bucket[i]];
+      block.within = row_offset[linearization_.key_variable(block_factor[bucket[i]], block.row_key)];
     }
-    total += factor_cost;
   }
-  *cost = total;
-  return true;
 }
 
 void NormalEquations::accumulate(int slot, double* jtj, double* gradient) const {
   std::fill(jtj, jtj + nonzeros(), 0.0);
   std::fill(gradient, gradient + columns_, 0.0);
-  const auto& factors = problem_.factors();
-  for (std::size_t fi = 0; fi < factors.size(); ++fi) {
-    const FactorLayout& f = layout_[fi];
-    const int m = factors[fi]->residual_dim();
-    const double* residual = residuals_[slot].data() + f.residual_offset;
-    const double* const* jacobians = jacobian_pointers_[slot].data() + f.key_offset;
-    const int nk = static_cast<int>(factors[fi]->keys().size());
+  const Linearization& lin = linearization_;
+  for (int f = 0; f < lin.factor_count(); ++f) {
+    const int m = lin.residual_dim(f);
+    const double* residual = lin.residuals(slot, f);
+    const int nk = lin.key_count(f);
     for (int k = 0; k < nk; ++k) {
-      const int column = key_column_[f.key_offset + k];
+      const int column = lin.key_column(f, k);
       if (column < 0) continue;
-      const int d = key_dim_[f.key_offset + k];
-      const double* J = jacobians[k];
+      const int d = lin.key_dim(f, k);
+      const double* J = lin.jacobian(slot, f, k);
       for (int i = 0; i < m; ++i) {
         for (int c = 0; c < d; ++c) gradient[column + c] += J[i * d + c] * residual[i];
       }
     }
-    for (int b = f.block_begin; b < f.block_end; ++b) {
+    for (int b = block_begin_[f]; b < block_begin_[f + 1]; ++b) {
       const BlockRef& block = blocks_[b];
-      const int dr = key_dim_[f.key_offset + block.row_key], dc = key_dim_[f.key_offset + block.column_key];
-      const double* Jr = jacobians[block.row_key];
-      const double* Jc = jacobians[block.column_key];
-      const int first_column = key_column_[f.key_offset + block.column_key];
+      const int dr = lin.key_dim(f, block.row_key), dc = lin.key_dim(f, block.column_key);
+      const double* Jr = lin.jacobian(slot, f, block.row_key);
+      const double* Jc = lin.jacobian(slot, f, block.column_key);
+      const int first_column = lin.key_column(f, block.column_key);
       const bool diagonal_block = block.row_key == block.column_key;
       for (int cl = 0; cl < dc; ++cl) {
         double* out = jtj + column_starts_[first_column + cl] + block.within;

@@ -1,14 +1,11 @@
 #include "solver/platform_statics.h"
 
 #include <cmath>
-
-#include <Eigen/LU>
+#include <utility>
 
 namespace cdpr {
 namespace {
 
-using Mat3x = Eigen::Matrix<double, 3, kStaticsParamDim>;
-using Mat6x = Eigen::Matrix<double, 6, kStaticsParamDim>;
 using Wrench = Eigen::Matrix<double, 6, 1>;
 
 const Eigen::Vector3d kUp = Eigen::Vector3d::UnitZ();
@@ -24,8 +21,6 @@ struct CableGeometry {
   Eigen::Vector3d lever_world;  // r_i = R b_i
   Eigen::Vector3d s_c;          // horizontal unit vector anchor -> attachment
   double span = 0.0;
-  Mat3x d_lever;  // d r_i / d x
-  Mat3x d_s_c;    // d s_c / d x
 };
 
 // Wrench columns of J^T for one cable, Eq. (8): f_h acts along -s_c, f_v along +z.
@@ -40,68 +35,194 @@ Wrench column_v(const CableGeometry& g) {
   return c;
 }
 
-}  // namespace
+// LU with partial pivoting of the 6x6 matrix of Eq. (11), in plain loops:
+// the statics solve it for one right-hand side and, with Jacobians, a dozen
+// more, where a generic blocked solver costs more than the arithmetic.
+class Lu6 {
+ public:
+  explicit Lu6(const Eigen::Matrix<double, 6, 6>& a) : lu_(a) {
+    for (int k = 0; k < 6; ++k) {
+      int pivot = k;
+      for (int r = k + 1; r < 6; ++r) {
+        if (std::abs(lu_(r, k)) > std::abs(lu_(pivot, k))) pivot = r;
+      }
+      perm_[k] = pivot;
+      if (pivot != k) {
+        lu_.row(k).swap(lu_.row(pivot));
+        determinant_ = -determinant_;
+      }
+      const double diagonal = lu_(k, k);
+      determinant_ *= diagonal;
+      if (diagonal == 0.0) continue;  // singular: determinant 0, the caller refuses
+      for (int r = k + 1; r < 6; ++r) {
+        const double factor = lu_(r, k) / diagonal;
+        lu_(r, k) = factor;
+        for (int c = k + 1; c < 6; ++c) lu_(r, c) -= factor * lu_(k, c);
+      }
+    }
+  }
+  double determinant() const { return determinant_; }
+  // x = A^-1 b.
+  Wrench solve(Wrench x) const {
+    for (int k = 0; k < 6; ++k) {
+      if (perm_[k] != k) std::swap(x(k), x(perm_[k]));
+    }
+    for (int r = 1; r < 6; ++r) {
+      for (int c = 0; c < r; ++c) x(r) -= lu_(r, c) * x(c);
+    }
+    for (int r = 5; r >= 0; --r) {
+      for (int c = r + 1; c < 6; ++c) x(r) -= lu_(r, c) * x(c);
+      x(r) /= lu_(r, r);
+    }
+    return x;
+  }
 
-StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in, bool with_jacobian,
-                                     std::array<CableStatics, kCableCount>& cables) {
-  const Eigen::Matrix3d R = in.world_T_platform.world_R_platform.toRotationMatrix();
-  const Eigen::Vector3d& p = in.world_T_platform.position_world;
-  const int ref = robot.reference_cable;
+ private:
+  Eigen::Matrix<double, 6, 6> lu_;
+  int perm_[6] = {};
+  double determinant_ = 1.0;
+};
 
+// Geometry of every cable, the weight's wrench and the 6x6 matrix of Eq. (11)
+// at one pose; kOk or why the statics are undefined there.
+struct Setup {
+  Eigen::Matrix3d R;
   std::array<CableGeometry, kCableCount> geo;
+  Eigen::Vector3d com_platform;
+  Wrench w;
+  Eigen::Matrix<double, 6, 6> A;
+  Wrench column_h_ref, column_v_ref;
+};
+
+StaticsStatus set_up(const Robot& robot, const StaticsInput& in, Setup& s,
+                     std::array<double, kCableCount>* span, std::array<double, kCableCount>* anchor_z,
+                     std::array<double, kCableCount>* attachment_z) {
+  s.R = in.world_T_platform.world_R_platform.toRotationMatrix();
+  const Eigen::Vector3d& p = in.world_T_platform.position_world;
   for (int i = 0; i < kCableCount; ++i) {
     const Eigen::Vector3d& b = robot.winches[i].attachment_platform;
-    CableGeometry& g = geo[i];
-    g.lever_world = R * b;
+    CableGeometry& g = s.geo[i];
+    g.lever_world = s.R * b;
     const Eigen::Vector3d d = p + g.lever_world - in.anchor_world[i];
     g.span = std::hypot(d.x(), d.y());
     if (!(g.span > 1e-9)) return StaticsStatus::kVerticalCable;
     g.s_c = Eigen::Vector3d(d.x() / g.span, d.y() / g.span, 0.0);
-
-    CableStatics& c = cables[i];
-    c.span = g.span;
-    c.anchor_z = in.anchor_world[i].z();
-    c.attachment_z = p.z() + g.lever_world.z();
-    if (!with_jacobian) continue;
-
-    // d r / d theta = -R [b]x (right perturbation); d d = d p + d r - d a.
-    g.d_lever.setZero();
-    g.d_lever.block<3, 3>(0, kStaticsPose + 3) = -R * skew3(b);
-    Mat3x d_d = g.d_lever;
-    d_d.block<3, 3>(0, kStaticsPose) += Eigen::Matrix3d::Identity();
-    d_d.block<3, 3>(0, kStaticsAnchor + 3 * i) -= Eigen::Matrix3d::Identity();
-    // s_c = P d / |P d|  =>  d s_c = (P - s_c s_c^T) d d / L, with P = diag(1, 1, 0).
-    Eigen::Matrix3d projector = Eigen::Vector3d(1.0, 1.0, 0.0).asDiagonal();
-    projector -= g.s_c * g.s_c.transpose();
-    g.d_s_c = projector * d_d / g.span;
-
-    c.d_span = g.s_c.transpose() * d_d;
-    c.d_anchor_z.setZero();
-    c.d_anchor_z(kStaticsAnchor + 3 * i + 2) = 1.0;
-    c.d_attachment_z = d_d.row(2);
-    c.d_attachment_z(kStaticsAnchor + 3 * i + 2) = 0.0;  // the attachment does not move with the anchor
+    (*span)[i] = g.span;
+    (*anchor_z)[i] = in.anchor_world[i].z();
+    (*attachment_z)[i] = p.z() + g.lever_world.z();
   }
 
   // Eq. (6): the cables carry the weight, acting at the centre of mass.
   const double weight_n = robot.platform_mass_kg * robot.gravity_mps2;
-  const Eigen::Vector3d com_world = R * (robot.center_of_mass_platform + in.com_offset_platform);
-  Wrench w;
-  w << weight_n * kUp, weight_n * com_world.cross(kUp);
+  s.com_platform = robot.center_of_mass_platform + in.com_offset_platform;
+  const Eigen::Vector3d com_world = s.R * s.com_platform;
+  s.w << weight_n * kUp, weight_n * com_world.cross(kUp);
 
   // Eq. (9)-(11): partition J^T into the reference cable and the rest.
-  Eigen::Matrix<double, 6, 6> A;
+  const int ref = robot.reference_cable;
   for (int i = 0, col = 0; i < kCableCount; ++i) {
     if (i == ref) continue;
-    A.col(col++) = column_h(geo[i]);
-    A.col(col++) = column_v(geo[i]);
+    s.A.col(col++) = column_h(s.geo[i]);
+    s.A.col(col++) = column_v(s.geo[i]);
   }
+  s.column_h_ref = column_h(s.geo[ref]);
+  s.column_v_ref = column_v(s.geo[ref]);
+  return StaticsStatus::kOk;
+}
+
+// A is dimensionless in forces and metres in moments; a pivot this small
+// means two cables' planes coincide and Eq. (11) has no unique solution.
+bool singular(const Lu6& lu) { return !(std::abs(lu.determinant()) > 1e-12); }
+
+}  // namespace
+
+StaticsStatus reference_force_map(const Robot& robot, const StaticsInput& in, ReferenceForceMap& map) {
+  Setup s;
+  if (const StaticsStatus status = set_up(robot, in, s, &map.span, &map.anchor_z, &map.attachment_z);
+      status != StaticsStatus::kOk) {
+    return status;
+  }
+  const Lu6 lu(s.A);
+  if (singular(lu)) return StaticsStatus::kSingular;
+  for (int k = 0; k < 6; ++k) map.inverse.col(k) = lu.solve(Wrench::Unit(k));
+  const Wrench offset = map.inverse * s.w;
+  const Wrench gain_h = -(map.inverse * s.column_h_ref), gain_v = -(map.inverse * s.column_v_ref);
+  map.reference = robot.reference_cable;
+  for (int i = 0, col = 0; i < kCableCount; ++i) {
+    const CableGeometry& g = s.geo[i];
+    map.lever[i] = g.lever_world;
+    map.s_c[i] = g.s_c;
+    map.t[i] = Eigen::Vector3d(-g.s_c.y(), g.s_c.x(), 0.0);
+    // d d / d yaw = z x r: the attachment swings round the vertical.
+    map.d_span_d_yaw[i] = g.s_c.dot(kUp.cross(g.lever_world));
+    if (i == robot.reference_cable) {
+      map.offset[i].setZero();
+      map.gain[i].setIdentity();
+      continue;
+    }
+    map.offset[i] = offset.segment<2>(col);
+    map.gain[i].col(0) = gain_h.segment<2>(col);
+    map.gain[i].col(1) = gain_v.segment<2>(col);
+    col += 2;
+  }
+  // w = [W z; W c x z] with c = R c_p turning too: d/d yaw = [0; W (z x c) x z].
+  const double weight_n = robot.platform_mass_kg * robot.gravity_mps2;
+  const Eigen::Vector3d com_world = s.R * s.com_platform;
+  map.d_weight_d_yaw << Eigen::Vector3d::Zero(), weight_n * kUp.cross(com_world).cross(kUp);
+  return StaticsStatus::kOk;
+}
+
+std::array<Eigen::Vector2d, kCableCount> ReferenceForceMap::d_force_d_yaw(const Eigen::Vector2d& f) const {
+  // As in solve_platform_statics' Jacobian, for the single direction of a
+  // turn about the vertical: d r = z x r, d s_c = t phi with
+  // phi = t' (z x r) / L, and E = d w - sum_i dW_i/d yaw at fixed forces.
+  Wrench e = d_weight_d_yaw;
+  for (int i = 0; i < kCableCount; ++i) {
+    const Eigen::Vector2d fi = offset[i] + gain[i] * f;
+    const Eigen::Vector3d d_lever = kUp.cross(lever[i]);
+    const double phi = t[i].dot(d_lever) / span[i];
+    const Eigen::Vector3d force = -fi.x() * s_c[i] + fi.y() * kUp;
+    e.head<3>() += fi.x() * phi * t[i];
+    e.tail<3>() += force.cross(d_lever) + fi.x() * phi * lever[i].cross(t[i]);
+  }
+  const Wrench d_rest = inverse * e;
+  std::array<Eigen::Vector2d, kCableCount> d;
+  for (int i = 0, col = 0; i < kCableCount; ++i) {
+    if (i == reference) {
+      d[i].setZero();
+      continue;
+    }
+    d[i] = d_rest.segment<2>(col);
+    col += 2;
+  }
+  return d;
+}
+
+StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in, bool with_jacobian,
+                                     std::array<CableStatics, kCableCount>& cables) {
+  const int ref = robot.reference_cable;
+  Setup s;
+  std::array<double, kCableCount> span, anchor_z, attachment_z;
+  if (const StaticsStatus status = set_up(robot, in, s, &span, &anchor_z, &attachment_z);
+      status != StaticsStatus::kOk) {
+    return status;
+  }
+  for (int i = 0; i < kCableCount; ++i) {
+    cables[i].span = span[i];
+    cables[i].anchor_z = anchor_z[i];
+    cables[i].attachment_z = attachment_z[i];
+  }
+  const Eigen::Matrix3d& R = s.R;
+  const std::array<CableGeometry, kCableCount>& geo = s.geo;
+  const Eigen::Vector3d& com_platform = s.com_platform;
+  const Wrench& column_h_ref = s.column_h_ref;
+  const Wrench& column_v_ref = s.column_v_ref;
+  const double weight_n = robot.platform_mass_kg * robot.gravity_mps2;
   const double f_h_ref = in.reference_force.x();
   const double f_v_ref = in.reference_force.y();
-  const Wrench rhs = w - f_h_ref * column_h(geo[ref]) - f_v_ref * column_v(geo[ref]);
-  const Eigen::PartialPivLU<Eigen::Matrix<double, 6, 6>> lu(A);
-  // A is dimensionless in forces and metres in moments; a pivot this small
-  // means two cables' planes coincide and Eq. (11) has no unique solution.
-  if (!(std::abs(lu.determinant()) > 1e-12)) return StaticsStatus::kSingular;
+  const Wrench rhs = s.w - f_h_ref * column_h_ref - f_v_ref * column_v_ref;
+  const Lu6 lu(s.A);
+  if (singular(lu)) return StaticsStatus::kSingular;
   const Wrench f_rest = lu.solve(rhs);
 
   for (int i = 0, col = 0; i < kCableCount; ++i) {
@@ -116,24 +237,69 @@ StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in,
   if (!with_jacobian) return StaticsStatus::kOk;
 
   // Implicit differentiation of sum_i W_i(f_i, x) = w(x):
-  //   A d f_rest = d w - sum_i dW_i/dx|_f - J_ref d f_ref.
-  // W_i = [F_i; r_i x F_i] with F_i = -f_h s_c + f_v z.
-  Mat6x E = Mat6x::Zero();
-  E.block<3, 3>(3, kStaticsPose + 3) = weight_n * skew3(kUp) * R * skew3(robot.center_of_mass_platform + in.com_offset_platform);
-  E.block<3, 3>(3, kStaticsCom) = -weight_n * skew3(kUp) * R;
+  //   A d f_rest = E = d w - sum_i dW_i/dx|_f - J_ref d f_ref,
+  // W_i = [F_i; r_i x F_i] with F_i = -f_h s_c + f_v z. With d = p + r - a
+  // and t = z x s_c, the horizontal direction moves as d s_c = t phi,
+  // phi = t' d d / L (rank one, as P - s_c s_c' = t t' for P = diag(1, 1, 0)),
+  // and d r = -R [b]x d theta. So E is a sum of outer products u_i phi_i,
+  // u_i = f_h [t; r x t], plus blocks in the rotation, centre-of-mass and
+  // reference-force columns: a dozen solves with A instead of one per column.
+  // The right-hand sides, then one product with A^-1 (formed once: fixed
+  // 6x6 products beat a dozen triangular solves).
+  Eigen::Matrix<double, 6, 12> e = Eigen::Matrix<double, 6, 12>::Zero();  // u_0..3, rotation (3), CoM (3), force (2)
+  constexpr int kU = 0, kRotation = 4, kCom = 7, kForce = 10;
+  e.block<3, 3>(3, kRotation) = weight_n * skew3(kUp) * R * skew3(com_platform);
+  std::array<Eigen::Matrix3d, kCableCount> d_lever;  // d r_i / d theta
+  std::array<Eigen::Matrix<double, 1, 7>, kCableCount> phi;  // over (p_x, p_y, theta (3), a_x, a_y)
   for (int i = 0; i < kCableCount; ++i) {
     const CableGeometry& g = geo[i];
+    d_lever[i] = -R * skew3(robot.winches[i].attachment_platform);
+    const Eigen::Vector3d t(-g.s_c.y(), g.s_c.x(), 0.0);
     const double f_h = cables[i].f_h;
     const Eigen::Vector3d force = -f_h * g.s_c + cables[i].f_v * kUp;
-    E.topRows<3>() += f_h * g.d_s_c;
-    E.bottomRows<3>() += skew3(force) * g.d_lever + f_h * skew3(g.lever_world) * g.d_s_c;
+    phi[i] << t.x() / g.span, t.y() / g.span, (t.transpose() * d_lever[i]) / g.span, -t.x() / g.span,
+        -t.y() / g.span;
+    e.col(kU + i) << f_h * t, f_h * g.lever_world.cross(t);
+    e.block<3, 3>(3, kRotation) += skew3(force) * d_lever[i];
   }
-  E.col(kStaticsForce) -= column_h(geo[ref]);
-  E.col(kStaticsForce + 1) -= column_v(geo[ref]);
-  const Mat6x d_f_rest = lu.solve(E);
+  e.block<3, 3>(3, kCom) = -weight_n * skew3(kUp) * R;
+  e.col(kForce) = -column_h_ref;
+  e.col(kForce + 1) = -column_v_ref;
+  Eigen::Matrix<double, 6, 6> inverse;
+  for (int k = 0; k < 6; ++k) inverse.col(k) = lu.solve(Wrench::Unit(k));
+  const Eigen::Matrix<double, 6, 12> g = inverse * e;
+  Eigen::Matrix<double, 6, kStaticsParamDim> d_f_rest = Eigen::Matrix<double, 6, kStaticsParamDim>::Zero();
+  d_f_rest.middleCols<3>(kStaticsPose + 3) = g.middleCols<3>(kRotation);
+  d_f_rest.middleCols<3>(kStaticsCom) = g.middleCols<3>(kCom);
+  d_f_rest.middleCols<2>(kStaticsForce) = g.middleCols<2>(kForce);
+  std::array<Wrench, kCableCount> v;  // A^-1 u_i
+  for (int i = 0; i < kCableCount; ++i) v[i] = g.col(kU + i);
+  for (int i = 0; i < kCableCount; ++i) {
+    const int anchor = kStaticsAnchor + 3 * i;
+    d_f_rest.col(kStaticsPose) += v[i] * phi[i](0);
+    d_f_rest.col(kStaticsPose + 1) += v[i] * phi[i](1);
+    d_f_rest.middleCols<3>(kStaticsPose + 3) += v[i] * phi[i].segment<3>(2);
+    d_f_rest.col(anchor) += v[i] * phi[i](5);
+    d_f_rest.col(anchor + 1) += v[i] * phi[i](6);
+  }
 
   for (int i = 0, col = 0; i < kCableCount; ++i) {
     CableStatics& c = cables[i];
+    const CableGeometry& g = geo[i];
+    const int anchor = kStaticsAnchor + 3 * i;
+    // span = |P d|: d span = s_c' d d.
+    c.d_span.setZero();
+    c.d_span(kStaticsPose) = g.s_c.x();
+    c.d_span(kStaticsPose + 1) = g.s_c.y();
+    c.d_span.segment<3>(kStaticsPose + 3) = g.s_c.transpose() * d_lever[i];
+    c.d_span(anchor) = -g.s_c.x();
+    c.d_span(anchor + 1) = -g.s_c.y();
+    c.d_anchor_z.setZero();
+    c.d_anchor_z(anchor + 2) = 1.0;
+    // The attachment moves with the pose, not with the anchor.
+    c.d_attachment_z.setZero();
+    c.d_attachment_z(kStaticsPose + 2) = 1.0;
+    c.d_attachment_z.segment<3>(kStaticsPose + 3) = d_lever[i].row(2);
     if (i == ref) {
       c.d_f_h.setZero();
       c.d_f_v.setZero();

@@ -54,4 +54,31 @@ enum class StaticsStatus {
 StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in, bool with_jacobian,
                                      std::array<CableStatics, kCableCount>& cables);
 
+// The same statics at a fixed pose, anchors and centre of mass, as the
+// affine map it is in the reference cable's force: cable i carries
+// (f_h, f_v)_i = offset[i] + gain[i] * (f_h, f_v)_ref (the reference cable:
+// offset 0, gain I). One factorisation of Eq. (11) then serves any number of
+// reference forces, e.g. a start's search over them. in.reference_force is
+// not read.
+struct ReferenceForceMap {
+  std::array<Eigen::Vector2d, kCableCount> offset;
+  std::array<Eigen::Matrix2d, kCableCount> gain;
+  std::array<double, kCableCount> span{}, anchor_z{}, attachment_z{};  // as in CableStatics
+
+  // Turning the pose about the world vertical through its origin (yaw, the
+  // start's heading search): d span_i / d yaw, and d (f_h, f_v)_i / d yaw at
+  // the reference force `f` held fixed (zero for the reference cable). The
+  // attachment heights do not change.
+  std::array<double, kCableCount> d_span_d_yaw{};
+  std::array<Eigen::Vector2d, kCableCount> d_force_d_yaw(const Eigen::Vector2d& f) const;
+
+  // What d_force_d_yaw needs: A^-1, each cable's lever R b and horizontal
+  // directions, d w / d yaw, the reference cable.
+  Eigen::Matrix<double, 6, 6> inverse;
+  std::array<Eigen::Vector3d, kCableCount> lever{}, s_c{}, t{};
+  Eigen::Matrix<double, 6, 1> d_weight_d_yaw;
+  int reference = 0;
+};
+StaticsStatus reference_force_map(const Robot& robot, const StaticsInput& in, ReferenceForceMap& map);
+
 }  // namespace cdpr

@@ -1,5 +1,6 @@
 #include "solver/problem.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 
@@ -27,7 +28,18 @@ void Problem::add_variable(Key key, int tangent_dim, int ambient_dim, bool is_po
   v.ambient_dim = ambient_dim;
   v.ambient_offset = static_cast<int>(state_.size());
   v.is_pose = is_pose;
-  index_.emplace(key, static_cast<int>(variables_.size()));
+  const int index = static_cast<int>(variables_.size());
+  const std::size_t kind = static_cast<std::size_t>(key.kind);
+  if (key.index >= 0 && key.index < kDenseIndexLimit) {
+    if (dense_index_.size() <= kind) dense_index_.resize(kind + 1);
+    std::vector<int>& table = dense_index_[kind];
+    if (table.size() <= static_cast<std::size_t>(key.index)) {
+      table.resize(std::max<std::size_t>(static_cast<std::size_t>(key.index) + 1, 2 * table.size()), -1);
+    }
+    table[key.index] = index;
+  } else {
+    sparse_index_.emplace(key, index);
+  }
   variables_.push_back(v);
   state_.insert(state_.end(), value, value + ambient_dim);
 }
@@ -46,7 +58,23 @@ void Problem::add_vector(Key key, const Eigen::VectorXd& value) {
 
 void Problem::set_constant(Key key, bool constant) {
   if (!has(key)) die("set_constant of unknown variable " + to_string(key));
-  variables_[index_.at(key)].constant = constant;
+  variables_[find(key)].constant = constant;
+}
+
+int Problem::find(Key key) const {
+  if (key.index >= 0 && key.index < kDenseIndexLimit) {
+    const std::size_t kind = static_cast<std::size_t>(key.kind);
+    if (kind >= dense_index_.size() || static_cast<std::size_t>(key.index) >= dense_index_[kind].size()) return -1;
+    return dense_index_[kind][key.index];
+  }
+  const auto it = sparse_index_.find(key);
+  return it == sparse_index_.end() ? -1 : it->second;
+}
+
+int Problem::variable_index(Key key) const {
+  const int v = find(key);
+  if (v < 0) die("unknown variable " + to_string(key));
+  return v;
 }
 
 void Problem::add_factor(std::unique_ptr<Factor> factor) {
@@ -67,9 +95,7 @@ void Problem::add_factor(std::unique_ptr<Factor> factor) {
 }
 
 const Problem::Variable& Problem::checked(Key key, bool is_pose) const {
-  const auto it = index_.find(key);
-  if (it == index_.end()) die("unknown variable " + to_string(key));
-  const Variable& v = variables_[it->second];
+  const Variable& v = variables_[variable_index(key)];
   if (v.is_pose != is_pose) die(to_string(key) + (is_pose ? " is not a pose" : " is a pose, not a vector"));
   return v;
 }

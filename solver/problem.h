@@ -26,7 +26,7 @@ class Problem {
   void set_constant(Key key, bool constant = true);           // held fixed by the solver
   void add_factor(std::unique_ptr<Factor> factor);            // keys must exist
 
-  bool has(Key key) const { return index_.count(key) > 0; }
+  bool has(Key key) const { return find(key) >= 0; }
   Pose pose(Key key) const;
   Eigen::VectorXd vector(Key key) const;
   void set_pose(Key key, const Pose& value);
@@ -41,7 +41,8 @@ class Problem {
     bool constant = false;
   };
   const std::vector<Variable>& variables() const { return variables_; }
-  int variable_index(Key key) const { return index_.at(key); }
+  // Index into variables(); aborts on an unknown key. O(1).
+  int variable_index(Key key) const;
   const std::vector<std::unique_ptr<Factor>>& factors() const { return factors_; }
 
   // Flat ambient state of all variables, in variables() order.
@@ -56,9 +57,14 @@ class Problem {
  private:
   void add_variable(Key key, int tangent_dim, int ambient_dim, bool is_pose, const double* value);
   const Variable& checked(Key key, bool is_pose) const;  // aborts on an unknown key or wrong kind
+  int find(Key key) const;                               // variable index, -1 if unknown
 
   std::vector<Variable> variables_;
-  std::map<Key, int> index_;
+  // Key -> variable index: a flat table per kind for the dense small indices
+  // every problem uses (pose k, cable i, ...), a map for any other index.
+  static constexpr int kDenseIndexLimit = 1 << 20;
+  std::vector<std::vector<int>> dense_index_;  // [kind][index], -1 where absent
+  std::map<Key, int> sparse_index_;
   std::vector<double> state_;
   std::vector<std::unique_ptr<Factor>> factors_;
 };

@@ -95,10 +95,12 @@ namespace cdpr {
 namespace {
 
 // 100 poses on a grid under 4 cables, each with a pose prior, 4 range
-// factors (Huber, with gross outliers) and a relative-pose factor, started
-// off the truth; plus one log factor whose first undamped step leaves its
-// domain, so the loop also runs through refused and rejected candidates.
-Problem realistic_problem(int* refusals) {
+// factors (Huber, with gross outliers) and, when `link_poses`, a
+// relative-pose factor, started off the truth; plus one log factor whose
+// first undamped step leaves its domain, so the loop also runs through
+// refused and rejected candidates. Linked poses make the solver factorise
+// the whole J^T J; without the links it eliminates the poses first.
+Problem realistic_problem(int* refusals, bool link_poses) {
   const std::array<Eigen::Vector3d, 4> anchors = {
       Eigen::Vector3d(0, 0, 20), Eigen::Vector3d(30, 0, 21), Eigen::Vector3d(30, 25, 19), Eigen::Vector3d(0, 25, 20)};
   const std::array<Eigen::Vector3d, 4> attachments = {
@@ -128,7 +130,7 @@ Problem realistic_problem(int* refusals) {
       problem.add_factor(std::make_unique<test::RangeFactor>(PoseKey(k), AnchorKey(i), OffsetKey(i), attachments[i],
                                                              encoder, 0.002, Loss{3.0}));
     }
-    if (k > 0) {
+    if (link_poses && k > 0) {
       Pose a_T_b;
       a_T_b.position_world =
           truth[k - 1].world_R_platform.conjugate() * (truth[k].position_world - truth[k - 1].position_world);
@@ -141,11 +143,12 @@ Problem realistic_problem(int* refusals) {
   return problem;
 }
 
-TEST(LevenbergMarquardtAllocation, IterationLoopAllocatesNothing) {
-  if (!CDPR_COUNT_ALLOCATIONS) GTEST_SKIP() << "allocation counting is off under AddressSanitizer";
+// Solves with the allocation counter on; the count between the first and
+// the last progress call is what the loop allocated.
+void expect_loop_allocates_nothing(bool link_poses, LinearSystemKind expected_system) {
   // GIVEN a realistic problem and a solver built for it (setup may allocate)
   int refusals = 0;
-  Problem problem = realistic_problem(&refusals);
+  Problem problem = realistic_problem(&refusals, link_poses);
   long first = -1, last = -1;
   int calls = 0, rejected = 0;
   SolverOptions options;
@@ -157,6 +160,7 @@ TEST(LevenbergMarquardtAllocation, IterationLoopAllocatesNothing) {
     rejected += s.iteration > 0 && !s.step_accepted;
   };
   LevenbergMarquardt lm(problem, options);
+  ASSERT_EQ(lm.linear_system(), expected_system);
   // WHEN solving with the counter on
   g_allocations = 0;
   g_counting = true;
@@ -176,6 +180,16 @@ TEST(LevenbergMarquardtAllocation, IterationLoopAllocatesNothing) {
   delete probe;
   g_counting = false;
   EXPECT_GE(g_allocations.load() - before, 4);
+}
+
+TEST(LevenbergMarquardtAllocation, IterationLoopAllocatesNothing) {
+  if (!CDPR_COUNT_ALLOCATIONS) GTEST_SKIP() << "allocation counting is off under AddressSanitizer";
+  expect_loop_allocates_nothing(true, LinearSystemKind::kFull);
+}
+
+TEST(LevenbergMarquardtAllocation, IterationLoopWithPosesEliminatedAllocatesNothing) {
+  if (!CDPR_COUNT_ALLOCATIONS) GTEST_SKIP() << "allocation counting is off under AddressSanitizer";
+  expect_loop_allocates_nothing(false, LinearSystemKind::kPosesEliminated);
 }
 
 }  // namespace

@@ -48,6 +48,26 @@ TEST(Problem, RetractsPosesOnTheRightAndVectorsAdditively) {
   EXPECT_EQ(problem.vector(OffsetKey(0))(0), 1.5);
 }
 
+TEST(Problem, FindsVariablesByKeyOfAnyIndex) {
+  // GIVEN keys with small, large and negative indices of several kinds
+  Problem problem;
+  problem.add_vector(AnchorKey(3), Eigen::Vector3d(1, 2, 3));
+  problem.add_pose(PoseKey(7), Pose{});
+  problem.add_vector(EffectKey(-2), Eigen::VectorXd::Constant(1, 4.0));
+  problem.add_vector(EffectKey(1 << 28), Eigen::VectorXd::Constant(2, 5.0));
+  // THEN each is found at its position, and absent ones are not
+  EXPECT_EQ(problem.variable_index(AnchorKey(3)), 0);
+  EXPECT_EQ(problem.variable_index(PoseKey(7)), 1);
+  EXPECT_EQ(problem.variable_index(EffectKey(-2)), 2);
+  EXPECT_EQ(problem.variable_index(EffectKey(1 << 28)), 3);
+  EXPECT_EQ(problem.vector(EffectKey(-2))(0), 4.0);
+  EXPECT_TRUE(problem.has(PoseKey(7)));
+  EXPECT_FALSE(problem.has(PoseKey(6)));
+  EXPECT_FALSE(problem.has(PoseKey(70)));
+  EXPECT_FALSE(problem.has(OffsetKey(0)));
+  EXPECT_FALSE(problem.has(EffectKey(-3)));
+}
+
 TEST(ProblemDeathTest, RefusesFactorsOnUnknownVariables) {
   // GIVEN a factor naming a variable that was never added; THEN abort with its name
   Problem problem;

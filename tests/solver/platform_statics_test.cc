@@ -1,5 +1,7 @@
 #include "solver/platform_statics.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "test_robots.h"
@@ -77,6 +79,49 @@ TEST(PlatformStatics, JacobianMatchesCentralDifferences) {
       check("anchor_z", exact[i].d_anchor_z(j), plus[i].anchor_z, minus[i].anchor_z, 1.0);
       check("attachment_z", exact[i].d_attachment_z(j), plus[i].attachment_z, minus[i].attachment_z, 1.0);
     }
+  }
+}
+
+TEST(PlatformStatics, ReferenceForceMapReproducesTheStaticsAndTheirTurn) {
+  // GIVEN the statics at a tilted pose as an affine map of the reference force
+  const Robot robot = test::large_robot();
+  const StaticsInput in = input_at(robot, {150.0, 60.0, 22.0});
+  ReferenceForceMap map;
+  ASSERT_EQ(reference_force_map(robot, in, map), StaticsStatus::kOk);
+  // THEN at any reference force it gives the forces of the full solve
+  auto solve_at = [&](const StaticsInput& at) {
+    std::array<CableStatics, kCableCount> cables;
+    EXPECT_EQ(solve_platform_statics(robot, at, false, cables), StaticsStatus::kOk);
+    return cables;
+  };
+  for (const Eigen::Vector2d& f : {Eigen::Vector2d(420.0, 160.0), Eigen::Vector2d(900.0, -50.0)}) {
+    StaticsInput at = in;
+    at.reference_force = f;
+    const auto cables = solve_at(at);
+    for (int i = 0; i < kCableCount; ++i) {
+      const Eigen::Vector2d mapped = map.offset[i] + map.gain[i] * f;
+      EXPECT_NEAR(mapped.x(), cables[i].f_h, 1e-9 * std::abs(cables[i].f_h) + 1e-9) << i;
+      EXPECT_NEAR(mapped.y(), cables[i].f_v, 1e-9 * std::abs(cables[i].f_v) + 1e-9) << i;
+      EXPECT_DOUBLE_EQ(map.span[i], cables[i].span);
+      EXPECT_DOUBLE_EQ(map.attachment_z[i], cables[i].attachment_z);
+    }
+  }
+  // AND its yaw derivatives match central differences of a turn about the world vertical
+  const double h = 1e-6;
+  auto turned = [&](double yaw) {
+    StaticsInput at = in;
+    at.world_T_platform.world_R_platform =
+        Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())) * in.world_T_platform.world_R_platform;
+    return solve_at(at);
+  };
+  const auto up = turned(h), down = turned(-h);
+  const std::array<Eigen::Vector2d, kCableCount> d_force = map.d_force_d_yaw(in.reference_force);
+  for (int i = 0; i < kCableCount; ++i) {
+    const double d_f_h = (up[i].f_h - down[i].f_h) / (2 * h), d_f_v = (up[i].f_v - down[i].f_v) / (2 * h);
+    EXPECT_NEAR(d_force[i].x(), d_f_h, 1e-5 * (1.0 + std::abs(d_f_h))) << i;
+    EXPECT_NEAR(d_force[i].y(), d_f_v, 1e-5 * (1.0 + std::abs(d_f_v))) << i;
+    EXPECT_NEAR(map.d_span_d_yaw[i], (up[i].span - down[i].span) / (2 * h), 1e-6) << i;
+    EXPECT_NEAR(up[i].attachment_z, down[i].attachment_z, 1e-9) << i;
   }
 }
 

@@ -1,0 +1,514 @@
+#include "solver/schur_complement.h"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+namespace cdpr {
+namespace {
+
+bool is_per_pose(const Key& key) {
+  return key.kind == VariableKind::kPose || key.kind == VariableKind::kReferenceForce;
+}
+
+// Dense kernels on one pose group's d x d blocks (column-major). D > 0 is d
+// known at compile time (the loops unroll for the common group sizes),
+// D = 0 takes the runtime `dim`.
+
+// In-place Cholesky A = U'U of a block whose upper triangle holds A; false
+// when A is not positive definite.
+template <int D>
+bool cholesky_upper(double* u, int dim) {
+  const int d = D > 0 ? D : dim;
+  for (int j = 0; j < d; ++j) {
+    double* uj = u + d * j;
+    for (int i = 0; i < j; ++i) {
+      const double* ui = u + d * i;
+      double s = uj[i];
+      for (int p = 0; p < i; ++p) s -= ui[p] * uj[p];
+      uj[i] = s / ui[i];
+    }
+    double s = uj[j];
+    for (int p = 0; p < j; ++p) s -= uj[p] * uj[p];
+    if (!(s > 0.0)) return false;
+    uj[j] = std::sqrt(s);
+  }
+  return true;
+}
+
+// Solves U'y = b in place (forward substitution).
+template <int D>
+void solve_upper_transposed(const double* u, int dim, double* y) {
+  const int d = D > 0 ? D : dim;
+  for (int i = 0; i < d; ++i) {
+    const double* ui = u + d * i;
+    double s = y[i];
+    for (int p = 0; p < i; ++p) s -= ui[p] * y[p];
+    y[i] = s / ui[i];
+  }
+}
+
+// Solves U x = b in place (back substitution).
+template <int D>
+void solve_upper(const double* u, int dim, double* x) {
+  const int d = D > 0 ? D : dim;
+  for (int i = d - 1; i >= 0; --i) {
+    double s = x[i];
+    for (int p = i + 1; p < d; ++p) s -= u[i + d * p] * x[p];
+    x[i] = s / u[i + d * i];
+  }
+}
+
+// One group's part of the factorisation: U'U = A + D_A / radius, W = U'^-1 B
+// and S -= W'W over its coupled columns (ascending, so into the upper
+// triangle of the n x n S).
+template <int D>
+bool eliminate_group(int dim, const double* a, double* u, const double* b, double* w, int m, const int* columns,
+                     double* s, int n, double radius, double min_diagonal, double max_diagonal) {
+  const int d = D > 0 ? D : dim;
+  for (int j = 0; j < d; ++j) {
+    for (int i = 0; i <= j; ++i) u[i + d * j] = a[i + d * j];
+    u[j + d * j] += std::clamp(a[j + d * j], min_diagonal, max_diagonal) / radius;
+  }
+  if (!cholesky_upper<D>(u, d)) return false;
+  std::copy(b, b + d * m, w);
+  for (int p = 0; p < m; ++p) solve_upper_transposed<D>(u, d, w + d * p);
+  for (int q = 0; q < m; ++q) {
+    const double* wq = w + d * q;
+    double* s_column = s + static_cast<std::size_t>(n) * columns[q];
+    for (int p = 0; p <= q; ++p) {
+      const double* wp = w + d * p;
+      double dot = 0.0;
+      for (int i = 0; i < d; ++i) dot += wp[i] * wq[i];
+      s_column[columns[p]] -= dot;
+    }
+  }
+  return true;
+}
+
+// The group's part of a solve, before the reduced system: y = U'^-1 b_l in
+// place, reduced right-hand side -= W'y.
+template <int D>
+void forward_group(int dim, const double* u, const double* w, int m, const int* columns, double* y, double* reduced) {
+  const int d = D > 0 ? D : dim;
+  solve_upper_transposed<D>(u, d, y);
+  for (int p = 0; p < m; ++p) {
+    double dot = 0.0;
+    for (int i = 0; i < d; ++i) dot += w[i + d * p] * y[i];
+    reduced[columns[p]] -= dot;
+  }
+}
+
+// ... and after it: x_l = U^-1 (y - W x_g) in place.
+template <int D>
+void backward_group(int dim, const double* u, const double* w, int m, const int* columns, const double* x_global,
+                    double* y) {
+  const int d = D > 0 ? D : dim;
+  for (int p = 0; p < m; ++p) {
+    const double xg = x_global[columns[p]];
+    for (int i = 0; i < d; ++i) y[i] -= w[i + d * p] * xg;
+  }
+  solve_upper<D>(u, d, y);
+}
+
+// out(r, c) += sum_i Ja(i, r) Jb(i, c), Ja and Jb row-major m x da and
+// m x db, out column-major with leading dimension `stride`. Sizes known at
+// compile time for the tangent sizes that occur (pose 6, anchor 3,
+// reference force 2, offset 1), so the small loops unroll.
+template <int DA, int DB>
+void add_block_fixed(int m, int, int, const double* ja, const double* jb, double* out, int stride) {
+  double sum[DA * DB] = {};
+  for (int i = 0; i < m; ++i) {
+    const double* a = ja + i * DA;
+    const double* b = jb + i * DB;
+#pragma GCC unroll 8
+    for (int c = 0; c < DB; ++c) {
+#pragma GCC unroll 8
+      for (int r = 0; r < DA; ++r) sum[r + DA * c] += a[r] * b[c];
+    }
+  }
+#pragma GCC unroll 8
+  for (int c = 0; c < DB; ++c) {
+#pragma GCC unroll 8
+    for (int r = 0; r < DA; ++r) out[r + stride * c] += sum[r + DA * c];
+  }
+}
+
+void add_block_any(int m, int da, int db, const double* ja, const double* jb, double* out, int stride) {
+  for (int c = 0; c < db; ++c) {
+    for (int r = 0; r < da; ++r) {
+      double sum = 0.0;
+      for (int i = 0; i < m; ++i) sum += ja[i * da + r] * jb[i * db + c];
+      out[r + stride * c] += sum;
+    }
+  }
+}
+
+template <int DA>
+SchurComplement::BlockKernel kernel_for(int db) {
+  switch (db) {
+    case 1: return add_block_fixed<DA, 1>;
+    case 2: return add_block_fixed<DA, 2>;
+    case 3: return add_block_fixed<DA, 3>;
+    case 6: return add_block_fixed<DA, 6>;
+    default: return add_block_any;
+  }
+}
+
+SchurComplement::BlockKernel kernel_for(int da, int db) {
+  switch (da) {
+    case 1: return kernel_for<1>(db);
+    case 2: return kernel_for<2>(db);
+    case 3: return kernel_for<3>(db);
+    case 6: return kernel_for<6>(db);
+    default: return add_block_any;
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<SchurComplement> SchurComplement::create(const Problem& problem) {
+  const auto& variables = problem.variables();
+  const int nv = static_cast<int>(variables.size());
+  // Pose groups by pose index, in order of first appearance.
+  std::vector<int> group_of(nv, -1);
+  std::unordered_map<int, int> group_of_pose;
+  std::vector<int> group_dim;
+  int global_dim = 0;
+  for (int v = 0; v < nv; ++v) {
+    if (variables[v].constant) continue;
+    if (!is_per_pose(variables[v].key)) {
+      global_dim += variables[v].tangent_dim;
+      continue;
+    }
+    const auto [it, inserted] = group_of_pose.emplace(variables[v].key.index, static_cast<int>(group_dim.size()));
+    if (inserted) group_dim.push_back(0);
+    group_of[v] = it->second;
+    group_dim[it->second] += variables[v].tangent_dim;
+    if (group_dim[it->second] > kMaxGroupDim) return nullptr;
+  }
+  if (group_dim.empty() || global_dim == 0 || global_dim > kMaxGlobalDim) return nullptr;
+  for (const auto& factor : problem.factors()) {
+    if (factor->keys().size() > 255) return nullptr;  // BlockOp holds key positions in a byte
+    int group = -1;
+    for (const Key& key : factor->keys()) {
+      const int g = group_of[problem.variable_index(key)];
+      if (g < 0) continue;
+      if (group >= 0 && g != group) return nullptr;  // couples two poses: not block diagonal
+      group = g;
+    }
+  }
+  // Columns: each group's variables together (in variable order), then the globals.
+  const int groups = static_cast<int>(group_dim.size());
+  std::vector<int> next_column(groups, 0);
+  int local_dim = 0;
+  for (int g = 0; g < groups; ++g) {
+    next_column[g] = local_dim;
+    local_dim += group_dim[g];
+  }
+  std::vector<int> variable_column(nv, -1);
+  int global_column = local_dim;
+  for (int v = 0; v < nv; ++v) {
+    if (variables[v].constant) continue;
+    int& column = group_of[v] >= 0 ? next_column[group_of[v]] : global_column;
+    variable_column[v] = column;
+    column += variables[v].tangent_dim;
+  }
+  return std::unique_ptr<SchurComplement>(
+      new SchurComplement(problem, std::move(variable_column), group_of, groups));
+}
+
+SchurComplement::SchurComplement(const Problem& problem, std::vector<int> variable_column,
+                                 const std::vector<int>& group_of, int group_count)
+    : linearization_(problem, std::move(variable_column)) {
+  const auto& variables = problem.variables();
+  const int nv = static_cast<int>(variables.size());
+  const int nf = linearization_.factor_count();
+  auto column_of = [&](int v) { return linearization_.variable_column(v); };
+
+  // Group sizes and columns.
+  groups_.assign(group_count, Group{});
+  for (Group& g : groups_) g.column = -1;
+  for (int v = 0; v < nv; ++v) {
+    const int g = group_of[v];
+    if (g < 0) {
+      if (column_of(v) >= 0) global_dim_ += variables[v].tangent_dim;
+      continue;
+    }
+    Group& group = groups_[g];
+    group.column = group.column < 0 ? column_of(v) : std::min(group.column, column_of(v));
+    group.dim += variables[v].tangent_dim;
+    local_dim_ += variables[v].tangent_dim;
+  }
+  const int n = global_dim_;
+  auto global_column = [&](int v) { return column_of(v) - local_dim_; };
+
+  // The global variables each group's factors reach, and each factor's group.
+  std::vector<std::vector<int>> coupled_variables(group_count);
+  std::vector<int> factor_group(nf, -1);
+  for (int f = 0; f < nf; ++f) {
+    for (int k = 0; k < linearization_.key_count(f); ++k) {
+      const int g = group_of[linearization_.key_variable(f, k)];
+      if (g >= 0) factor_group[f] = g;
+    }
+    const int g = factor_group[f];
+    if (g < 0) continue;
+    for (int k = 0; k < linearization_.key_count(f); ++k) {
+      const int v = linearization_.key_variable(f, k);
+      if (group_of[v] < 0 && column_of(v) >= 0) coupled_variables[g].push_back(v);
+    }
+  }
+  int block_total = 0, coupling_total = 0;
+  for (int g = 0; g < group_count; ++g) {
+    std::vector<int>& list = coupled_variables[g];
+    std::sort(list.begin(), list.end(), [&](int x, int y) { return column_of(x) < column_of(y); });
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+    Group& group = groups_[g];
+    group.coupled_begin = static_cast<int>(coupled_.size());
+    for (int v : list) {
+      for (int d = 0; d < variables[v].tangent_dim; ++d) coupled_.push_back(global_column(v) + d);
+    }
+    group.coupled_end = static_cast<int>(coupled_.size());
+    group.block = block_total;
+    group.coupling = coupling_total;
+    block_total += group.dim * group.dim;
+    coupling_total += group.dim * (group.coupled_end - group.coupled_begin);
+  }
+  a_.assign(block_total, 0.0);
+  factor_.assign(block_total, 0.0);
+  b_.assign(coupling_total, 0.0);
+  w_.assign(coupling_total, 0.0);
+  c_.assign(static_cast<std::size_t>(n) * n, 0.0);
+  s_.assign(static_cast<std::size_t>(n) * n, 0.0);
+  reduced_rhs_.assign(n, 0.0);
+
+  // Block operations of every factor: each pair of non-constant keys once,
+  // oriented so the block lands in an upper triangle or in B.
+  op_begin_.reserve(nf + 1);
+  for (int f = 0; f < nf; ++f) {
+    op_begin_.push_back(static_cast<int>(ops_.size()));
+    const int nk = linearization_.key_count(f);
+    for (int a = 0; a < nk; ++a) {
+      for (int b = a; b < nk; ++b) {
+        int ka = a, kb = b;
+        int va = linearization_.key_variable(f, ka), vb = linearization_.key_variable(f, kb);
+        if (column_of(va) < 0 || column_of(vb) < 0) continue;
+        const bool local_a = group_of[va] >= 0, local_b = group_of[vb] >= 0;
+        BlockOp op{};
+        if (local_a && local_b) {
+          if (column_of(va) > column_of(vb)) {
+            std::swap(ka, kb);
+            std::swap(va, vb);
+          }
+          const Group& group = groups_[group_of[va]];
+          op = {static_cast<unsigned char>(ka), static_cast<unsigned char>(kb), kLocal,
+                group.block + (column_of(va) - group.column) + group.dim * (column_of(vb) - group.column), group.dim,
+                nullptr};
+        } else if (local_a || local_b) {
+          if (!local_a) {
+            std::swap(ka, kb);
+            std::swap(va, vb);
+          }
+          const Group& group = groups_[group_of[va]];
+          const int position = static_cast<int>(
+              std::find(coupled_.begin() + group.coupled_begin, coupled_.begin() + group.coupled_end, global_column(vb)) -
+              (coupled_.begin() + group.coupled_begin));
+          op = {static_cast<unsigned char>(ka), static_cast<unsigned char>(kb), kCoupling,
+                group.coupling + (column_of(va) - group.column) + group.dim * position, group.dim, nullptr};
+        } else {
+          if (column_of(va) > column_of(vb)) {
+            std::swap(ka, kb);
+            std::swap(va, vb);
+          }
+          op = {static_cast<unsigned char>(ka), static_cast<unsigned char>(kb), kGlobal,
+                global_column(va) + n * global_column(vb), n, nullptr};
+        }
+        op.kernel = kernel_for(linearization_.key_dim(f, op.a), linearization_.key_dim(f, op.b));
+        ops_.push_back(op);
+      }
+    }
+  }
+  op_begin_.push_back(static_cast<int>(ops_.size()));
+
+  // Pattern of S over the global variables: a block for every pair of
+  // global variables one group couples to or one factor names, and the
+  // diagonal blocks.
+  std::vector<int> global_variables;
+  for (int v = 0; v < nv; ++v) {
+    if (group_of[v] < 0 && column_of(v) >= 0) global_variables.push_back(v);
+  }
+  std::sort(global_variables.begin(), global_variables.end(),
+            [&](int x, int y) { return column_of(x) < column_of(y); });
+  std::vector<std::vector<int>> block_rows(nv);
+  auto add_pair = [&](int x, int y) {
+    if (column_of(x) > column_of(y)) std::swap(x, y);
+    block_rows[y].push_back(x);
+  };
+  for (int v : global_variables) add_pair(v, v);
+  for (int g = 0; g < group_count; ++g) {
+    const std::vector<int>& list = coupled_variables[g];
+    // Neighbouring groups usually reach the same globals: skip repeats.
+    if (g > 0 && list == coupled_variables[g - 1]) continue;
+    for (std::size_t q = 0; q < list.size(); ++q) {
+      for (std::size_t p = 0; p < q; ++p) add_pair(list[p], list[q]);
+    }
+  }
+  for (int f = 0; f < nf; ++f) {
+    for (int op = op_begin_[f]; op < op_begin_[f + 1]; ++op) {
+      if (ops_[op].target != kGlobal) continue;
+      add_pair(linearization_.key_variable(f, ops_[op].a), linearization_.key_variable(f, ops_[op].b));
+    }
+  }
+  s_starts_.assign(n + 1, 0);
+  for (int v : global_variables) {
+    std::vector<int>& rows = block_rows[v];
+    std::sort(rows.begin(), rows.end(), [&](int x, int y) { return column_of(x) < column_of(y); });
+    rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+    for (int d = 0; d < variables[v].tangent_dim; ++d) {
+      const int c = global_column(v) + d;
+      for (int r : rows) {
+        const int first = global_column(r);
+        const int last = r == v ? c : first + variables[r].tangent_dim - 1;
+        for (int row = first; row <= last; ++row) s_rows_.push_back(row);
+      }
+      s_starts_[c + 1] = static_cast<int>(s_rows_.size());
+    }
+  }
+  s_values_.assign(s_rows_.size(), 0.0);
+  cholesky_ = std::make_unique<SparseCholesky>(n, s_starts_, s_rows_);
+}
+
+SchurComplement::~SchurComplement() = default;
+
+void SchurComplement::accumulate(int slot, double* gradient) {
+  std::fill(a_.begin(), a_.end(), 0.0);
+  std::fill(b_.begin(), b_.end(), 0.0);
+  std::fill(c_.begin(), c_.end(), 0.0);
+  std::fill(gradient, gradient + columns(), 0.0);
+  const Linearization& lin = linearization_;
+  double* targets[3] = {a_.data(), b_.data(), c_.data()};
+  for (int f = 0; f < lin.factor_count(); ++f) {
+    const int m = lin.residual_dim(f);
+    const double* residual = lin.residuals(slot, f);
+    for (int k = 0; k < lin.key_count(f); ++k) {
+      const int column = lin.key_column(f, k);
+      if (column < 0) continue;
+      const int d = lin.key_dim(f, k);
+      const double* J = lin.jacobian(slot, f, k);
+      for (int i = 0; i < m; ++i) {
+        for (int c = 0; c < d; ++c) gradient[column + c] += J[i * d + c] * residual[i];
+      }
+    }
+    for (int o = op_begin_[f]; o < op_begin_[f + 1]; ++o) {
+      const BlockOp& op = ops_[o];
+      const int da = lin.key_dim(f, op.a), db = lin.key_dim(f, op.b);
+      const double* Ja = lin.jacobian(slot, f, op.a);
+      const double* Jb = lin.jacobian(slot, f, op.b);
+      op.kernel(m, da, db, Ja, Jb, targets[op.target] + op.offset, op.stride);
+    }
+  }
+}
+
+FactorizationStatus SchurComplement::factorize(double radius, double min_diagonal, double max_diagonal,
+                                               std::string* message) {
+  const int n = global_dim_;
+  std::copy(c_.begin(), c_.end(), s_.begin());
+  for (int c = 0; c < n; ++c) {
+    const std::size_t d = c + static_cast<std::size_t>(n) * c;
+    s_[d] += std::clamp(c_[d], min_diagonal, max_diagonal) / radius;
+  }
+  for (std::size_t gi = 0; gi < groups_.size(); ++gi) {
+    const Group& g = groups_[gi];
+    const int d = g.dim, m = g.coupled_end - g.coupled_begin;
+    const double* a = a_.data() + g.block;
+    double* u = factor_.data() + g.block;
+    const double* b = b_.data() + g.coupling;
+    double* w = w_.data() + g.coupling;
+    const int* columns = coupled_.data() + g.coupled_begin;
+    bool ok;
+    switch (d) {  // the sizes of a pose group: pose + reference force, or a pose alone
+      case 8: ok = eliminate_group<8>(d, a, u, b, w, m, columns, s_.data(), n, radius, min_diagonal, max_diagonal); break;
+      case 6: ok = eliminate_group<6>(d, a, u, b, w, m, columns, s_.data(), n, radius, min_diagonal, max_diagonal); break;
+      default: ok = eliminate_group<0>(d, a, u, b, w, m, columns, s_.data(), n, radius, min_diagonal, max_diagonal);
+    }
+    if (!ok) {
+      bool finite = true;
+      for (int k = 0; k < d * d; ++k) finite = finite && std::isfinite(a[k]);
+      if (message) {
+        *message = finite ? "matrix not positive definite (the block of pose group " + std::to_string(gi) + ")"
+                          : "matrix entry of pose group " + std::to_string(gi) + " is not finite";
+      }
+      return finite ? FactorizationStatus::kNotPositiveDefinite : FactorizationStatus::kFatal;
+    }
+  }
+  for (int c = 0; c < n; ++c) {
+    for (int k = s_starts_[c]; k < s_starts_[c + 1]; ++k) {
+      s_values_[k] = s_[s_rows_[k] + static_cast<std::size_t>(n) * c];
+    }
+  }
+  return cholesky_->factorize(s_values_.data(), message);
+}
+
+void SchurComplement::solve(const double* b, double* x) {
+  const int n = global_dim_;
+  std::copy(b + local_dim_, b + local_dim_ + n, reduced_rhs_.begin());
+  for (const Group& g : groups_) {
+    const int d = g.dim, m = g.coupled_end - g.coupled_begin;
+    const double* u = factor_.data() + g.block;
+    const double* w = w_.data() + g.coupling;
+    const int* columns = coupled_.data() + g.coupled_begin;
+    double* y = x + g.column;
+    if (x != b) std::copy(b + g.column, b + g.column + d, y);
+    switch (d) {
+      case 8: forward_group<8>(d, u, w, m, columns, y, reduced_rhs_.data()); break;
+      case 6: forward_group<6>(d, u, w, m, columns, y, reduced_rhs_.data()); break;
+      default: forward_group<0>(d, u, w, m, columns, y, reduced_rhs_.data());
+    }
+  }
+  double* x_global = x + local_dim_;
+  cholesky_->solve(reduced_rhs_.data(), x_global);
+  for (const Group& g : groups_) {
+    const int d = g.dim, m = g.coupled_end - g.coupled_begin;
+    const double* u = factor_.data() + g.block;
+    const double* w = w_.data() + g.coupling;
+    const int* columns = coupled_.data() + g.coupled_begin;
+    double* y = x + g.column;
+    switch (d) {
+      case 8: backward_group<8>(d, u, w, m, columns, x_global, y); break;
+      case 6: backward_group<6>(d, u, w, m, columns, x_global, y); break;
+      default: backward_group<0>(d, u, w, m, columns, x_global, y);
+    }
+  }
+}
+
+double SchurComplement::quadratic(const double* x) const {
+  const int n = global_dim_;
+  const double* x_global = x + local_dim_;
+  double sum = 0.0;
+  for (const Group& g : groups_) {
+    const int d = g.dim, m = g.coupled_end - g.coupled_begin;
+    const double* a = a_.data() + g.block;
+    const double* b = b_.data() + g.coupling;
+    const int* columns = coupled_.data() + g.coupled_begin;
+    const double* xl = x + g.column;
+    for (int j = 0; j < d; ++j) {
+      double off = 0.0;
+      for (int i = 0; i < j; ++i) off += a[i + d * j] * xl[i];
+      sum += xl[j] * (2.0 * off + a[j + d * j] * xl[j]);
+    }
+    for (int p = 0; p < m; ++p) {
+      double dot = 0.0;
+      for (int i = 0; i < d; ++i) dot += b[i + d * p] * xl[i];
+      sum += 2.0 * dot * x_global[columns[p]];
+    }
+  }
+  for (int j = 0; j < n; ++j) {
+    const double* c = c_.data() + static_cast<std::size_t>(n) * j;
+    double off = 0.0;
+    for (int i = 0; i < j; ++i) off += c[i] * x_global[i];
+    sum += x_global[j] * (2.0 * off + c[j] * x_global[j]);
+  }
+  return sum;
+}
+
+}  // namespace cdpr

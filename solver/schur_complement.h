@@ -1,0 +1,98 @@
+#pragma once
+// The normal equations of a Problem whose per-pose variables can be
+// eliminated first (Ceres' SPARSE_SCHUR in spirit): the variables of each
+// static pose k (PoseKey(k), ReferenceForceKey(k)) form a small "local"
+// group that no factor shares with another pose; everything else (anchors,
+// offsets, model terms) is "global". Then
+//
+//   [ A   B ] [x_l]   [b_l]        S = C - B' A^-1 B   (reduced matrix)
+//   [ B'  C ] [x_g] = [b_g],       S x_g = b_g - B' A^-1 b_l,
+//                                   x_l = A^-1 (b_l - B x_g),
+//
+// with A block diagonal (one dense block per pose, Cholesky in place) and S
+// over the global variables only, factorised by CHOLMOD (SparseCholesky) in
+// a pattern analysed once. An iteration costs O(poses) small dense
+// operations plus one factorisation of S, whatever the number of poses.
+//
+// Everything is sized in the constructor, in time linear in the number of
+// factor keys; evaluate(), accumulate(), factorize() and solve() allocate
+// nothing. The problem's structure must not change while this object lives.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "solver/linearization.h"
+#include "solver/problem.h"
+#include "solver/sparse_cholesky.h"
+
+namespace cdpr {
+
+class SchurComplement {
+ public:
+  // Null when the problem lacks the structure: no per-pose or no global
+  // variable, a factor touching two poses' variables, a pose group larger
+  // than kMaxGroupDim or more than kMaxGlobalDim global dimensions (then the
+  // whole J^T J is the better system to factorise).
+  static constexpr int kMaxGroupDim = 16;
+  static constexpr int kMaxGlobalDim = 512;
+  static std::unique_ptr<SchurComplement> create(const Problem& problem);
+  ~SchurComplement();
+
+  int columns() const { return local_dim_ + global_dim_; }  // per-pose columns first, then global ones
+  int variable_column(int v) const { return linearization_.variable_column(v); }
+  Linearization& linearization() { return linearization_; }
+
+  // J^T J (kept inside) and J^T r (into `gradient`, columns() values) of `slot`.
+  void accumulate(int slot, double* gradient);
+  // Factorises J^T J + D / radius, D = diag(J^T J) clamped to
+  // [min_diagonal, max_diagonal]; radius = infinity for J^T J itself.
+  FactorizationStatus factorize(double radius, double min_diagonal, double max_diagonal, std::string* message);
+  // x = (J^T J + D / radius)^-1 b with the last successful factorisation; x may alias b.
+  void solve(const double* b, double* x);
+  // x' J^T J x.
+  double quadratic(const double* x) const;
+
+  // out(r, c) += sum_i Ja(i, r) Jb(i, c) for row-major m x da and m x db blocks.
+  using BlockKernel = void (*)(int m, int da, int db, const double* ja, const double* jb, double* out, int stride);
+
+ private:
+  struct Group {
+    int column = 0;        // first (local) column
+    int dim = 0;
+    int block = 0;         // offset of its dim x dim block in a_ and factor_
+    int coupling = 0;      // offset of its dim x coupled block in b_ and w_
+    int coupled_begin = 0; // into coupled_: the global columns its poses' factors reach, ascending
+    int coupled_end = 0;
+  };
+  // One block J_a' J_b of a factor's keys a, b added into `target` at
+  // `offset` (column-major, leading dimension `stride`).
+  enum Target : unsigned char { kLocal, kCoupling, kGlobal };
+  struct BlockOp {
+    unsigned char a, b;
+    Target target;
+    int offset;
+    int stride;
+    BlockKernel kernel;  // compiled for (da, db) when they are common sizes
+  };
+
+  // group_of[v]: the pose group of variable v, -1 for global or constant ones.
+  SchurComplement(const Problem& problem, std::vector<int> variable_column, const std::vector<int>& group_of,
+                  int group_count);
+
+  Linearization linearization_;
+  int local_dim_ = 0, global_dim_ = 0;
+  std::vector<Group> groups_;
+  std::vector<int> coupled_;             // global columns (0-based among the globals)
+  std::vector<double> a_, factor_;       // per group: J^T J block (upper), its damped Cholesky factor U (A = U'U)
+  std::vector<double> b_, w_;            // per group: coupling block B, then W = U'^-1 B
+  std::vector<double> c_, s_;            // global x global, column-major upper: C, then the reduced S
+  std::vector<BlockOp> ops_;             // per factor, in order
+  std::vector<int> op_begin_;            // per factor into ops_ (+1 at the end)
+  std::vector<int> s_starts_, s_rows_;   // pattern of S (upper, CSC)
+  std::vector<double> s_values_;
+  std::vector<double> reduced_rhs_;
+  std::unique_ptr<SparseCholesky> cholesky_;
+};
+
+}  // namespace cdpr
