@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "solver/pose_design.h"
 #include "src/formats/calibration_toml.h"
 #include "src/formats/robot_toml.h"
 #include "src/formats/samples_csv.h"
@@ -216,6 +217,36 @@ TEST(SimDataset, NoEffectsMeansEmptyEffectsTableAndEncoderIsArcPlusOffset) {
       EXPECT_NEAR(data.samples[k].encoder_m[i], data.states[k].cables[i].arc_length_m + data.truth.winches[i].offset_m,
                   1e-12);
     }
+  }
+}
+
+}  // namespace
+}  // namespace cdpr::sim
+
+namespace cdpr::sim {
+namespace {
+
+TEST(SimDataset, ADesignMeasuresTheMostInformativeOfTheCandidates) {
+  // GIVEN the small robot, 8 poses in a wide box, spread evenly or chosen from 60 candidates
+  DatasetConfig config = noiseless(Preset::kSmall, 8);
+  config.anchor_perturbation_m = 1.0;
+  config.workspace_min = Eigen::Vector3d(1.0, 0.5, 2.0);
+  config.workspace_max = Eigen::Vector3d(11.5, 4.0, 22.0);
+  const SimulatedDataset even = simulate(config);
+  config.design_candidates = 60;
+  const SimulatedDataset designed = simulate(config);
+  // THEN both have 8 samples, and the design's poses allow smaller anchor and offset variances
+  ASSERT_EQ(designed.samples.size(), 8u);
+  const auto poses = [](const SimulatedDataset& data) {
+    std::vector<Pose> p;
+    for (const Equilibrium& state : data.states) p.push_back(state.world_T_platform);
+    return p;
+  };
+  EXPECT_LT(design_variance_sum(designed.nominal, poses(designed)), 0.5 * design_variance_sum(even.nominal, poses(even)));
+  // AND the samples are the true states of those poses, in sequence order with ids 0..7
+  for (std::size_t k = 0; k < designed.samples.size(); ++k) {
+    EXPECT_EQ(designed.samples[k].id, static_cast<int>(k));
+    EXPECT_LT((designed.samples[k].position_world - designed.states[k].world_T_platform.position_world).norm(), 1e-9);
   }
 }
 

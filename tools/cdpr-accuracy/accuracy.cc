@@ -18,6 +18,7 @@ RunResult run_case(const Case& c, std::uint64_t seed) {
   config.noise_scale = c.noise_scale;
   config.workspace_min = c.workspace_min;
   config.workspace_max = c.workspace_max;
+  config.design_candidates = c.design_candidates;
   const auto data = sim::simulate_dataset(config);
   if (!data) {
     run.message = "simulation failed: " + data.error();

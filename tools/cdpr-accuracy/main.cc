@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   int poses = 35, seeds = 50, first_seed = 1;
   double perturbation = -1.0;
   std::vector<double> workspace;
+  int design_candidates = 0;
   bool model_check_only = false, verbose = false;
   app.add_option("--preset", preset_name, "large | small")->check(CLI::IsMember({"large", "small"}))->capture_default_str();
   app.add_option("--poses", poses, "static poses per data set")->capture_default_str();
@@ -32,6 +33,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--workspace", workspace, "waypoint box xmin,ymin,zmin,xmax,ymax,zmax [m] (default: the preset's)")
       ->delimiter(',')->expected(6);
+  app.add_option("--design", design_candidates,
+                 "0: poses spread evenly over the box; N: the most informative of N feasible candidates "
+                 "(D-optimal on the nominal anchors, solver/pose_design.h)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_flag("--model-check", model_check_only, "only run the Table I model check");
   app.add_flag("-v,--verbose", verbose, "one line per run");
   CLI11_PARSE(app, argc, argv);
@@ -59,6 +64,7 @@ int main(int argc, char** argv) {
     c.workspace_min = Eigen::Vector3d(workspace[0], workspace[1], workspace[2]);
     c.workspace_max = Eigen::Vector3d(workspace[3], workspace[4], workspace[5]);
   }
+  c.design_candidates = design_candidates;
   std::vector<cdpr::CableModelKind> models;
   if (model != "rigid") models.push_back(cdpr::CableModelKind::kCatenary);
   if (model != "catenary") models.push_back(cdpr::CableModelKind::kRigid);

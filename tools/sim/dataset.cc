@@ -6,6 +6,7 @@
 #include "sim/sensors.h"
 #include "sim/stream_purpose.h"
 #include "sim/waypoints.h"
+#include "solver/pose_design.h"
 
 namespace cdpr::sim {
 namespace {
@@ -65,10 +66,16 @@ Expected<SimulatedDataset, std::string> simulate_dataset(const DatasetConfig& co
   SolverOptions options;
   options.segments = config.segments;
   WaypointSequence waypoints(spec, config.seed);
-  const int max_candidates = config.pose_count * config.max_candidates_per_pose;
-  for (int tried = 0; static_cast<int>(data.samples.size()) < config.pose_count; ++tried) {
+  const int wanted = std::max(config.pose_count, config.design_candidates);
+  const int max_candidates = wanted * config.max_candidates_per_pose;
+  struct Feasible {
+    int candidate;
+    Equilibrium state;
+  };
+  std::vector<Feasible> feasible;
+  for (int tried = 0; static_cast<int>(feasible.size()) < wanted; ++tried) {
     if (tried == max_candidates) {
-      return Unexpected{"only " + std::to_string(data.samples.size()) + " of " + std::to_string(config.pose_count) +
+      return Unexpected{"only " + std::to_string(feasible.size()) + " of " + std::to_string(wanted) +
                         " poses have a taut equilibrium after " + std::to_string(tried) + " candidates"};
     }
     const Waypoint w = waypoints.next();
@@ -77,10 +84,22 @@ Expected<SimulatedDataset, std::string> simulate_dataset(const DatasetConfig& co
       ++data.skipped_candidates;
       continue;
     }
-    Rng noise = Rng::stream(config.seed, kStreamSensorNoise, static_cast<std::uint64_t>(w.candidate));
+    feasible.push_back({w.candidate, *state});
+  }
+  if (config.design_candidates > 0) {
+    std::vector<Pose> poses;
+    for (const Feasible& f : feasible) poses.push_back(f.state.world_T_platform);
+    std::vector<int> chosen = choose_informative_poses(data.nominal, poses, config.pose_count);
+    std::sort(chosen.begin(), chosen.end());  // sample order = sequence order, as without a design
+    std::vector<Feasible> measured;
+    for (int k : chosen) measured.push_back(std::move(feasible[k]));
+    feasible = std::move(measured);
+  }
+  for (const Feasible& f : feasible) {
+    Rng noise = Rng::stream(config.seed, kStreamSensorNoise, static_cast<std::uint64_t>(f.candidate));
     data.samples.push_back(
-        measure(data.true_robot, *state, config.noise_scale, noise, static_cast<int>(data.samples.size())));
-    data.states.push_back(*state);
+        measure(data.true_robot, f.state, config.noise_scale, noise, static_cast<int>(data.samples.size())));
+    data.states.push_back(f.state);
   }
   return data;
 }

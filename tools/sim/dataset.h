@@ -37,6 +37,12 @@ struct DatasetConfig {
   // Waypoint box (platform origin, world) instead of the preset's, e.g. the
   // wider spread a calibration plan uses for observability; both or neither.
   std::optional<Eigen::Vector3d> workspace_min, workspace_max;
+  // Pose design. 0: the first pose_count feasible candidates of the waypoint
+  // sequence (an even spread). N > 0: N feasible candidates, of which the
+  // pose_count most informative about anchors and offsets are measured
+  // (solver/pose_design.h, D-optimal, judged with the NOMINAL anchors as a
+  // planner must).
+  int design_candidates = 0;
   int segments = 2000;                // sim/cable_shooting.h
   int max_candidates_per_pose = 20;   // give up after this many candidates per wanted pose
 };
