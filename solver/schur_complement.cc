@@ -4,6 +4,8 @@
 #include <cmath>
 #include <unordered_map>
 
+#include <Eigen/Core>
+
 namespace cdpr {
 namespace {
 
@@ -59,28 +61,41 @@ void solve_upper(const double* u, int dim, double* x) {
   }
 }
 
-// One group's part of the factorisation: U'U = A + D_A / radius, W = U'^-1 B
-// and S -= W'W over its coupled columns (ascending, so into the upper
-// triangle of the n x n S).
+// B and W are d x m row-major (a row per local column, contiguous over the
+// m coupled global columns), so the work below runs along contiguous rows.
+using Row = Eigen::Map<Eigen::VectorXd>;
+using ConstRow = Eigen::Map<const Eigen::VectorXd>;
+
+// One group's part of the factorisation: U'U = A + D_A / radius,
+// W = U'^-1 B and S -= W'W over its coupled columns (ascending, so into the
+// upper triangle of the n x n S; `first` >= 0 when they are the contiguous
+// columns first, first + 1, ...).
 template <int D>
 bool eliminate_group(int dim, const double* a, double* u, const double* b, double* w, int m, const int* columns,
-                     double* s, int n, double radius, double min_diagonal, double max_diagonal) {
+                     int first, double* s, int n, double radius, double min_diagonal, double max_diagonal) {
   const int d = D > 0 ? D : dim;
   for (int j = 0; j < d; ++j) {
     for (int i = 0; i <= j; ++i) u[i + d * j] = a[i + d * j];
     u[j + d * j] += std::clamp(a[j + d * j], min_diagonal, max_diagonal) / radius;
   }
   if (!cholesky_upper<D>(u, d)) return false;
-  std::copy(b, b + d * m, w);
-  for (int p = 0; p < m; ++p) solve_upper_transposed<D>(u, d, w + d * p);
-  for (int q = 0; q < m; ++q) {
-    const double* wq = w + d * q;
-    double* s_column = s + static_cast<std::size_t>(n) * columns[q];
-    for (int p = 0; p <= q; ++p) {
-      const double* wp = w + d * p;
-      double dot = 0.0;
-      for (int i = 0; i < d; ++i) dot += wp[i] * wq[i];
-      s_column[columns[p]] -= dot;
+  // Forward substitution row by row: w_i = (b_i - sum_{p<i} U_pi w_p) / U_ii.
+  for (int i = 0; i < d; ++i) {
+    Row wi(w + i * m, m);
+    wi = ConstRow(b + i * m, m);
+    for (int p = 0; p < i; ++p) wi -= u[p + d * i] * ConstRow(w + p * m, m);
+    wi /= u[i + d * i];
+  }
+  // S -= sum_i w_i w_i' (upper triangle).
+  for (int i = 0; i < d; ++i) {
+    const double* wi = w + i * m;
+    for (int q = 0; q < m; ++q) {
+      if (first >= 0) {
+        Row(s + first + static_cast<std::size_t>(n) * (first + q), q + 1) -= wi[q] * ConstRow(wi, q + 1);
+      } else {
+        double* s_column = s + static_cast<std::size_t>(n) * columns[q];
+        for (int p = 0; p <= q; ++p) s_column[columns[p]] -= wi[p] * wi[q];
+      }
     }
   }
   return true;
@@ -92,10 +107,8 @@ template <int D>
 void forward_group(int dim, const double* u, const double* w, int m, const int* columns, double* y, double* reduced) {
   const int d = D > 0 ? D : dim;
   solve_upper_transposed<D>(u, d, y);
-  for (int p = 0; p < m; ++p) {
-    double dot = 0.0;
-    for (int i = 0; i < d; ++i) dot += w[i + d * p] * y[i];
-    reduced[columns[p]] -= dot;
+  for (int i = 0; i < d; ++i) {
+    for (int p = 0; p < m; ++p) reduced[columns[p]] -= w[i * m + p] * y[i];
   }
 }
 
@@ -104,9 +117,10 @@ template <int D>
 void backward_group(int dim, const double* u, const double* w, int m, const int* columns, const double* x_global,
                     double* y) {
   const int d = D > 0 ? D : dim;
-  for (int p = 0; p < m; ++p) {
-    const double xg = x_global[columns[p]];
-    for (int i = 0; i < d; ++i) y[i] -= w[i + d * p] * xg;
+  for (int i = 0; i < d; ++i) {
+    double dot = 0.0;
+    for (int p = 0; p < m; ++p) dot += w[i * m + p] * x_global[columns[p]];
+    y[i] -= dot;
   }
   solve_upper<D>(u, d, y);
 }
@@ -269,6 +283,10 @@ SchurComplement::SchurComplement(const Problem& problem, std::vector<int> variab
       for (int d = 0; d < variables[v].tangent_dim; ++d) coupled_.push_back(global_column(v) + d);
     }
     group.coupled_end = static_cast<int>(coupled_.size());
+    group.contiguous = true;
+    for (int k = group.coupled_begin + 1; k < group.coupled_end; ++k) {
+      group.contiguous = group.contiguous && coupled_[k] == coupled_[k - 1] + 1;
+    }
     group.block = block_total;
     group.coupling = coupling_total;
     block_total += group.dim * group.dim;
@@ -305,16 +323,19 @@ SchurComplement::SchurComplement(const Problem& problem, std::vector<int> variab
                 group.block + (column_of(va) - group.column) + group.dim * (column_of(vb) - group.column), group.dim,
                 nullptr};
         } else if (local_a || local_b) {
-          if (!local_a) {
+          // B row-major: its transpose, column-major with leading dimension
+          // m, takes the global key's rows and the local key's columns.
+          if (local_a) {
             std::swap(ka, kb);
             std::swap(va, vb);
           }
-          const Group& group = groups_[group_of[va]];
+          const Group& group = groups_[group_of[vb]];
+          const int m = group.coupled_end - group.coupled_begin;
           const int position = static_cast<int>(
-              std::find(coupled_.begin() + group.coupled_begin, coupled_.begin() + group.coupled_end, global_column(vb)) -
+              std::find(coupled_.begin() + group.coupled_begin, coupled_.begin() + group.coupled_end, global_column(va)) -
               (coupled_.begin() + group.coupled_begin));
           op = {static_cast<unsigned char>(ka), static_cast<unsigned char>(kb), kCoupling,
-                group.coupling + (column_of(va) - group.column) + group.dim * position, group.dim, nullptr};
+                group.coupling + position + m * (column_of(vb) - group.column), m, nullptr};
         } else {
           if (column_of(va) > column_of(vb)) {
             std::swap(ka, kb);
@@ -425,11 +446,12 @@ FactorizationStatus SchurComplement::factorize(double radius, double min_diagona
     const double* b = b_.data() + g.coupling;
     double* w = w_.data() + g.coupling;
     const int* columns = coupled_.data() + g.coupled_begin;
+    const int first = g.contiguous ? (m > 0 ? columns[0] : 0) : -1;
     bool ok;
     switch (d) {  // the sizes of a pose group: pose + reference force, or a pose alone
-      case 8: ok = eliminate_group<8>(d, a, u, b, w, m, columns, s_.data(), n, radius, min_diagonal, max_diagonal); break;
-      case 6: ok = eliminate_group<6>(d, a, u, b, w, m, columns, s_.data(), n, radius, min_diagonal, max_diagonal); break;
-      default: ok = eliminate_group<0>(d, a, u, b, w, m, columns, s_.data(), n, radius, min_diagonal, max_diagonal);
+      case 8: ok = eliminate_group<8>(d, a, u, b, w, m, columns, first, s_.data(), n, radius, min_diagonal, max_diagonal); break;
+      case 6: ok = eliminate_group<6>(d, a, u, b, w, m, columns, first, s_.data(), n, radius, min_diagonal, max_diagonal); break;
+      default: ok = eliminate_group<0>(d, a, u, b, w, m, columns, first, s_.data(), n, radius, min_diagonal, max_diagonal);
     }
     if (!ok) {
       bool finite = true;
@@ -496,10 +518,10 @@ double SchurComplement::quadratic(const double* x) const {
       for (int i = 0; i < j; ++i) off += a[i + d * j] * xl[i];
       sum += xl[j] * (2.0 * off + a[j + d * j] * xl[j]);
     }
-    for (int p = 0; p < m; ++p) {
+    for (int i = 0; i < d; ++i) {
       double dot = 0.0;
-      for (int i = 0; i < d; ++i) dot += b[i + d * p] * xl[i];
-      sum += 2.0 * dot * x_global[columns[p]];
+      for (int p = 0; p < m; ++p) dot += b[i * m + p] * x_global[columns[p]];
+      sum += 2.0 * dot * xl[i];
     }
   }
   for (int j = 0; j < n; ++j) {

@@ -64,6 +64,7 @@ class SchurComplement {
     int coupling = 0;      // offset of its dim x coupled block in b_ and w_
     int coupled_begin = 0; // into coupled_: the global columns its poses' factors reach, ascending
     int coupled_end = 0;
+    bool contiguous = false;  // coupled columns are consecutive
   };
   // One block J_a' J_b of a factor's keys a, b added into `target` at
   // `offset` (column-major, leading dimension `stride`).
@@ -85,7 +86,7 @@ class SchurComplement {
   std::vector<Group> groups_;
   std::vector<int> coupled_;             // global columns (0-based among the globals)
   std::vector<double> a_, factor_;       // per group: J^T J block (upper), its damped Cholesky factor U (A = U'U)
-  std::vector<double> b_, w_;            // per group: coupling block B, then W = U'^-1 B
+  std::vector<double> b_, w_;            // per group, row-major: coupling block B, then W = U'^-1 B
   std::vector<double> c_, s_;            // global x global, column-major upper: C, then the reduced S
   std::vector<BlockOp> ops_;             // per factor, in order
   std::vector<int> op_begin_;            // per factor into ops_ (+1 at the end)

@@ -2,6 +2,7 @@
 // numeric refactorisation, one covariance extraction.
 
 #include <algorithm>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include "bench_problems.h"
 #include "solver/keys.h"
 #include "solver/normal_equations.h"
+#include "solver/schur_complement.h"
 #include "solver/sparse_cholesky.h"
 #include "solver/static_pose_factor.h"
 
@@ -50,10 +52,11 @@ void BM_StaticPoseFactorEvaluate(benchmark::State& state) {
   }
 }
 
-// SparseCholesky::factorize of the damped J^T J at the start, in the
-// solver's own pattern (NormalEquations), on a SparseCholesky constructed
-// like the solver's: the numeric refactorisation of one LM iteration
-// (symbolic analysis done once, outside the loop).
+// SparseCholesky::factorize of the whole damped J^T J at the start, in
+// NormalEquations' pattern, on a SparseCholesky constructed like the
+// solver's full system: the numeric refactorisation of one LM iteration on
+// problems whose poses cannot be eliminated (the calibration's own graph
+// takes BM_SchurRefactorisation's path). Symbolic analysis outside the loop.
 void BM_NumericRefactorisation(benchmark::State& state) {
   BuiltProblem built = build_problem(bench_data(kKernelPoses));
   NormalEquations normal(*built.problem);
@@ -78,6 +81,34 @@ void BM_NumericRefactorisation(benchmark::State& state) {
   }
   state.counters["columns"] = normal.columns();
   state.counters["nonzeros"] = normal.nonzeros();
+}
+
+// The refactorisation our solver does per iteration on a calibration
+// problem: the per-pose blocks damped, Cholesky-factorised and eliminated
+// (Schur complement), and CHOLMOD's numeric factorisation of the reduced
+// matrix over the 16 global columns; at the start, damping of radius 1e4.
+// Per pose count, to show it grows linearly.
+void BM_SchurRefactorisation(benchmark::State& state) {
+  BuiltProblem built = build_problem(bench_data(static_cast<int>(state.range(0))));
+  std::unique_ptr<SchurComplement> schur = SchurComplement::create(*built.problem);
+  if (!schur) {
+    state.SkipWithError("the calibration problem has no per-pose structure");
+    return;
+  }
+  double cost = 0.0;
+  int failed = -1;
+  if (!schur->linearization().evaluate(built.problem->state().data(), 0, &cost, &failed)) {
+    state.SkipWithError("factor not evaluable at the start");
+    return;
+  }
+  std::vector<double> gradient(schur->columns());
+  schur->accumulate(0, gradient.data());
+  const double radius = our_options().initial_trust_radius;
+  std::string message;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(schur->factorize(radius, 1e-6, 1e32, &message));
+  }
+  state.counters["columns"] = schur->columns();
 }
 
 // LevenbergMarquardt::covariance of the 4 anchors and 4 offsets (16
@@ -107,6 +138,7 @@ void BM_ConstructOurSolver(benchmark::State& state) {
 BENCHMARK(BM_ConstructOurSolver)->ArgName("poses")->Arg(35)->Arg(1000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_StaticPoseFactorEvaluate)->Unit(benchmark::kNanosecond);
 BENCHMARK(BM_NumericRefactorisation)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SchurRefactorisation)->ArgName("poses")->Arg(35)->Arg(1000)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Covariance)->Unit(benchmark::kMicrosecond);
 
 }  // namespace

@@ -54,7 +54,7 @@ void print_summary() {
   for (const auto& [key, runs] : records()) pose_counts.insert(std::get<2>(key));
   if (pose_counts.empty()) return;
 
-  std::printf("\nSummary (medians of all recorded runs; Ceres single-threaded, SuiteSparse)\n");
+  std::printf("\nSummary (medians of all recorded runs, thread CPU time; Ceres single-threaded, SuiteSparse)\n");
   std::printf("%6s %-12s %6s %16s %10s %10s %10s %12s %12s\n", "poses", "solver", "iters", "final cost",
               "rel diff", "e2e ms", "solve ms", "ms/iter", "e2e ratio");
   for (int poses : pose_counts) {
