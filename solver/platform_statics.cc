@@ -40,45 +40,63 @@ Wrench column_v(const CableGeometry& g) {
 // more, where a generic blocked solver costs more than the arithmetic.
 class Lu6 {
  public:
-  explicit Lu6(const Eigen::Matrix<double, 6, 6>& a) : lu_(a) {
+  explicit Lu6(const Eigen::Matrix<double, 6, 6>& a) {
+    for (int r = 0; r < 6; ++r) {
+      for (int c = 0; c < 6; ++c) lu_[r][c] = a(r, c);
+    }
     for (int k = 0; k < 6; ++k) {
       int pivot = k;
       for (int r = k + 1; r < 6; ++r) {
-        if (std::abs(lu_(r, k)) > std::abs(lu_(pivot, k))) pivot = r;
+        if (std::abs(lu_[r][k]) > std::abs(lu_[pivot][k])) pivot = r;
       }
       perm_[k] = pivot;
       if (pivot != k) {
-        lu_.row(k).swap(lu_.row(pivot));
+        for (int c = 0; c < 6; ++c) std::swap(lu_[k][c], lu_[pivot][c]);
         determinant_ = -determinant_;
       }
-      const double diagonal = lu_(k, k);
+      const double diagonal = lu_[k][k];
       determinant_ *= diagonal;
-      if (diagonal == 0.0) continue;  // singular: determinant 0, the caller refuses
+      if (diagonal == 0.0) {  // singular: determinant 0, the caller refuses
+        inverse_diagonal_[k] = 0.0;
+        continue;
+      }
+      inverse_diagonal_[k] = 1.0 / diagonal;
       for (int r = k + 1; r < 6; ++r) {
-        const double factor = lu_(r, k) / diagonal;
-        lu_(r, k) = factor;
-        for (int c = k + 1; c < 6; ++c) lu_(r, c) -= factor * lu_(k, c);
+        const double factor = lu_[r][k] * inverse_diagonal_[k];
+        lu_[r][k] = factor;
+#pragma GCC unroll 6
+        for (int c = k + 1; c < 6; ++c) lu_[r][c] -= factor * lu_[k][c];
       }
     }
   }
   double determinant() const { return determinant_; }
   // x = A^-1 b.
-  Wrench solve(Wrench x) const {
-    for (int k = 0; k < 6; ++k) {
-      if (perm_[k] != k) std::swap(x(k), x(perm_[k]));
-    }
+  Wrench solve(const Wrench& b) const {
+    double x[6] = {b(0), b(1), b(2), b(3), b(4), b(5)};
+#pragma GCC unroll 6
+    for (int k = 0; k < 6; ++k) std::swap(x[k], x[perm_[k]]);
+#pragma GCC unroll 6
     for (int r = 1; r < 6; ++r) {
-      for (int c = 0; c < r; ++c) x(r) -= lu_(r, c) * x(c);
+      double sum = x[r];
+#pragma GCC unroll 6
+      for (int c = 0; c < r; ++c) sum -= lu_[r][c] * x[c];
+      x[r] = sum;
     }
+#pragma GCC unroll 6
     for (int r = 5; r >= 0; --r) {
-      for (int c = r + 1; c < 6; ++c) x(r) -= lu_(r, c) * x(c);
-      x(r) /= lu_(r, r);
+      double sum = x[r];
+#pragma GCC unroll 6
+      for (int c = r + 1; c < 6; ++c) sum -= lu_[r][c] * x[c];
+      x[r] = sum * inverse_diagonal_[r];
     }
-    return x;
+    Wrench out;
+    out << x[0], x[1], x[2], x[3], x[4], x[5];
+    return out;
   }
 
  private:
-  Eigen::Matrix<double, 6, 6> lu_;
+  double lu_[6][6];
+  double inverse_diagonal_[6];
   int perm_[6] = {};
   double determinant_ = 1.0;
 };

@@ -131,20 +131,13 @@ void backward_group(int dim, const double* u, const double* w, int m, const int*
 // reference force 2, offset 1), so the small loops unroll.
 template <int DA, int DB>
 void add_block_fixed(int m, int, int, const double* ja, const double* jb, double* out, int stride) {
-  double sum[DA * DB] = {};
+  Eigen::Matrix<double, DA, DB> sum = Eigen::Matrix<double, DA, DB>::Zero();
   for (int i = 0; i < m; ++i) {
-    const double* a = ja + i * DA;
-    const double* b = jb + i * DB;
-#pragma GCC unroll 8
-    for (int c = 0; c < DB; ++c) {
-#pragma GCC unroll 8
-      for (int r = 0; r < DA; ++r) sum[r + DA * c] += a[r] * b[c];
-    }
+    sum.noalias() += Eigen::Map<const Eigen::Matrix<double, DA, 1>>(ja + i * DA) *
+                     Eigen::Map<const Eigen::Matrix<double, 1, DB>>(jb + i * DB);
   }
-#pragma GCC unroll 8
   for (int c = 0; c < DB; ++c) {
-#pragma GCC unroll 8
-    for (int r = 0; r < DA; ++r) out[r + stride * c] += sum[r + DA * c];
+    for (int r = 0; r < DA; ++r) out[r + stride * c] += sum(r, c);
   }
 }
 
