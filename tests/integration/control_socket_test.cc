@@ -217,8 +217,8 @@ TEST(ControlSocket, UnderLoadAndAbuseStatusIsServedAndTheRunKeepsStepping) {
   for (const auto& [state, progress] : seen) states += " " + state + "@" + std::to_string(progress);
   EXPECT_GE(seen.size(), 4u) << "the run did not move on under load; seen" << states << "; last " << last_state
                              << ": " << last_reason;
-  std::printf("states seen under load:%s; %d status answers, %d abuse answers\n", states.c_str(),
-              answers_during_run, abuse_answers.load());
+  std::printf("states seen under load:%s (last: %s: %s); %d status answers, %d abuse answers\n", states.c_str(),
+              last_state.c_str(), last_reason.c_str(), answers_during_run, abuse_answers.load());
   // AND every client was answered throughout, abusers with errors, and nobody was dropped
   EXPECT_TRUE(problems.empty()) << problems.size() << " problems, first: " << problems.front();
   EXPECT_GT(answers_during_run, 1000);
