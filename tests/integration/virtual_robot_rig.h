@@ -47,6 +47,12 @@ inline daemon::DaemonConfig fast_daemon_config(const std::string& dir, const vir
   config.calibrator.equilibrium.window_us = 1'000'000;
   config.calibrator.equilibrium.max_speed_mps = 0.03;
   config.calibrator.equilibrium.max_angular_rate_radps = 0.06;
+  // The virtual robot answers CAN, Modbus and the pose stream from the thread
+  // that also solves its physics, on a machine shared with the other tests:
+  // a stall of a few hundred ms is the test machine, not a fault under test
+  // (the fault tests with injected clocks cover silent nodes and stale poses).
+  config.winches.heartbeat_timeout_us = 3'000'000;
+  config.calibrator.monitor.pose_stale_us = 3'000'000;
   return config;
 }
 
@@ -79,6 +85,7 @@ class VirtualRobotRig {
     config = fast_daemon_config(dir, *robot);
     if (options.preset == sim::Preset::kSmall) use_small_robot_limits(config);
     drivers::can::CanWinchBankConfig winch_config;
+    winch_config.heartbeat_timeout_us = config.winches.heartbeat_timeout_us;
     for (const daemon::WinchNodes& w : config.winches.winches) {
       winch_config.winches.push_back({w.drive_node_id, w.encoder_node_id, w.encoder_m_per_count, w.drive_m_per_count});
     }
