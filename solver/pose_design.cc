@@ -47,10 +47,16 @@ DesignInformation pose_information(const Robot& robot, const Pose& pose) {
   prior.head<3>().setConstant(1.0 / (robot.noise.position_m * robot.noise.position_m));
   prior.tail<3>().setConstant(1.0 / (robot.noise.orientation_rad * robot.noise.orientation_rad));
 
-  const Eigen::Matrix<double, 6, 6> i_pose =
-      w_encoder * j_pose.transpose() * j_pose + Eigen::Matrix<double, 6, 6>(prior.asDiagonal());
-  const Eigen::Matrix<double, 6, kDesignParameters> i_cross = w_encoder * j_pose.transpose() * j_parameters;
-  const DesignInformation i_parameters = w_encoder * j_parameters.transpose() * j_parameters;
+  // Products first, then scaled: GCC 12 at -O1 with the sanitizers warns
+  // (maybe-uninitialized) on Eigen's scalar-times-transpose product expressions.
+  const Eigen::Matrix<double, 6, kCableCount> j_pose_t = j_pose.transpose();
+  Eigen::Matrix<double, 6, 6> i_pose = j_pose_t * j_pose;
+  i_pose *= w_encoder;
+  i_pose.diagonal() += prior;
+  Eigen::Matrix<double, 6, kDesignParameters> i_cross = j_pose_t * j_parameters;
+  i_cross *= w_encoder;
+  DesignInformation i_parameters = j_parameters.transpose() * j_parameters;
+  i_parameters *= w_encoder;
   // Schur complement: what is left about the parameters once the pose is estimated too.
   return i_parameters - i_cross.transpose() * i_pose.llt().solve(i_cross);
 }

@@ -50,9 +50,13 @@ DesignInformation numeric_information(const Robot& robot, const Pose& pose) {
   Eigen::Matrix<double, 6, 6> prior = Eigen::Matrix<double, 6, 6>::Zero();
   prior.diagonal().head<3>().setConstant(1.0 / (robot.noise.position_m * robot.noise.position_m));
   prior.diagonal().tail<3>().setConstant(1.0 / (robot.noise.orientation_rad * robot.noise.orientation_rad));
-  const Eigen::Matrix<double, 6, 6> i_pose = w * j_pose.transpose() * j_pose + prior;
-  const Eigen::Matrix<double, 6, kDesignParameters> i_cross = w * j_pose.transpose() * j_parameters;
-  return w * j_parameters.transpose() * j_parameters - i_cross.transpose() * i_pose.inverse() * i_cross;
+  // Products first, then scaled (GCC 12 -O1 with sanitizers: see pose_design.cc).
+  const Eigen::Matrix<double, 6, kCableCount> j_pose_t = j_pose.transpose();
+  const Eigen::Matrix<double, 6, 6> i_pose = Eigen::Matrix<double, 6, 6>(j_pose_t * j_pose) * w + prior;
+  const Eigen::Matrix<double, 6, kDesignParameters> i_cross =
+      Eigen::Matrix<double, 6, kDesignParameters>(j_pose_t * j_parameters) * w;
+  const DesignInformation i_parameters = DesignInformation(j_parameters.transpose() * j_parameters) * w;
+  return i_parameters - i_cross.transpose() * i_pose.inverse() * i_cross;
 }
 
 Pose tilted_pose(const Eigen::Vector3d& position) {
