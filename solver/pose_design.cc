@@ -18,10 +18,22 @@ DesignInformation ridge(const Robot& robot) {
   return kRidgeRelative * per_reading * DesignInformation::Identity();
 }
 
-double variance_sum(const DesignInformation& information) {
+DesignInformation covariance(const DesignInformation& information) {
   const Eigen::LDLT<DesignInformation> ldlt(information);
-  if (ldlt.info() != Eigen::Success) return std::numeric_limits<double>::infinity();
-  return ldlt.solve(DesignInformation::Identity()).trace();
+  if (ldlt.info() != Eigen::Success) {
+    DesignInformation unknown = DesignInformation::Zero();
+    unknown.diagonal().setConstant(std::numeric_limits<double>::infinity());
+    return unknown;
+  }
+  return ldlt.solve(DesignInformation::Identity());
+}
+
+double variance_sum(const DesignInformation& information) { return covariance(information).trace(); }
+
+DesignInformation total_information(const Robot& robot, const std::vector<Pose>& poses) {
+  DesignInformation total = ridge(robot);
+  for (const Pose& pose : poses) total += pose_information(robot, pose);
+  return total;
 }
 
 }  // namespace
@@ -89,9 +101,11 @@ std::vector<int> choose_informative_poses(const Robot& robot, const std::vector<
 }
 
 double design_variance_sum(const Robot& robot, const std::vector<Pose>& poses) {
-  DesignInformation total = ridge(robot);
-  for (const Pose& pose : poses) total += pose_information(robot, pose);
-  return variance_sum(total);
+  return variance_sum(total_information(robot, poses));
+}
+
+DesignInformation design_covariance(const Robot& robot, const std::vector<Pose>& poses) {
+  return covariance(total_information(robot, poses));
 }
 
 }  // namespace cdpr

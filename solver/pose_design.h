@@ -41,4 +41,9 @@ std::vector<int> choose_informative_poses(const Robot& robot, const std::vector<
 // allows (Cramer-Rao, same ridge), to compare designs.
 double design_variance_sum(const Robot& robot, const std::vector<Pose>& poses);
 
+// Cramer-Rao covariance of anchors and offsets (straight cables, same ridge):
+// the least any unbiased calibration from these poses can achieve with the
+// encoders and pose tracker alone. Infinite diagonal when singular.
+DesignInformation design_covariance(const Robot& robot, const std::vector<Pose>& poses);
+
 }  // namespace cdpr

@@ -105,12 +105,26 @@ TEST(PoseDesign, InformativePosesBeatAnEvenSpreadOnTheSmallRobot) {
   // THEN the chosen design allows the smaller variances, and its anchor sigma (Cramer-Rao) is smaller
   EXPECT_LT(design_variance_sum(robot, informative), design_variance_sum(robot, even));
   const auto anchor_sigma = [&](const std::vector<Pose>& poses) {
-    DesignInformation total = DesignInformation::Identity() * 1e-6;
-    for (const Pose& pose : poses) total += pose_information(robot, pose);
-    const DesignInformation covariance = total.inverse();
+    const DesignInformation covariance = design_covariance(robot, poses);
     return std::sqrt(covariance.diagonal().head<3 * kCableCount>().sum() / kCableCount);
   };
   EXPECT_LT(anchor_sigma(informative), 0.5 * anchor_sigma(even));
+}
+
+TEST(PoseDesign, CovarianceIsTheInverseOfTheSummedInformation) {
+  const Robot robot = test::small_robot();
+  std::vector<Pose> poses;
+  for (double x : {2.0, 10.0}) {
+    for (double y : {1.0, 3.5}) {
+      for (double z : {4.0, 20.0}) poses.push_back(tilted_pose(Eigen::Vector3d(x, y, z)));
+    }
+  }
+  DesignInformation information = DesignInformation::Zero();
+  for (const Pose& pose : poses) information += pose_information(robot, pose);
+  const DesignInformation covariance = design_covariance(robot, poses);
+  // Up to the design's tiny ridge, which only matters in unseen directions.
+  EXPECT_LT((covariance * information - DesignInformation::Identity()).norm(), 1e-4);
+  EXPECT_NEAR(covariance.trace(), design_variance_sum(robot, poses), 1e-12 * covariance.trace());
 }
 
 }  // namespace

@@ -30,6 +30,12 @@ TEST(Accuracy, NoiselessDataIsRecoveredExactlyFromTenMetrePerturbation) {
   ASSERT_TRUE(run.ok) << run.message;
   EXPECT_LT(run.anchor_error_m, 1e-4);
   EXPECT_LT(run.offset_error_m, 1e-4);
+  // AND the fit's sigmas (the catenary model's Cramer-Rao bound here) are of the size the
+  // straight-cable bound of the same poses predicts: sag moves the cable directions a little
+  // and adds the force per pose as an unknown, it does not change what the encoders can tell
+  EXPECT_GT(run.straight_bound_m, 0.01);
+  EXPECT_GT(run.reported_sigma_m, 0.5 * run.straight_bound_m);
+  EXPECT_LT(run.reported_sigma_m, 2.0 * run.straight_bound_m);
 }
 
 TEST(Accuracy, LargeRobotWithWideWaypointsBeatsPaperAndRigidModel) {

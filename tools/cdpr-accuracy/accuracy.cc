@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "sim/dataset.h"
+#include "solver/pose_design.h"
 
 namespace cdpr::accuracy {
 
@@ -32,6 +33,10 @@ RunResult run_case(const Case& c, std::uint64_t seed) {
   run.iterations = result.solver.iterations;
   const std::vector<WinchTruth>& truth = data->truth.winches;
   const int n = static_cast<int>(truth.size());
+  std::vector<Pose> true_poses;
+  for (const sim::Equilibrium& state : data->states) true_poses.push_back(state.world_T_platform);
+  const DesignInformation bound = design_covariance(data->true_robot.robot, true_poses);
+  for (int i = 0; i < n; ++i) run.straight_bound_m += std::sqrt(bound.block<3, 3>(3 * i, 3 * i).trace()) / n;
   for (int i = 0; i < n; ++i) {
     if (!result.ok) {
       // Scored as no calibration at all: the nominal guess stays in force.
@@ -44,6 +49,7 @@ RunResult run_case(const Case& c, std::uint64_t seed) {
     const double offset_error = w.offset_m - truth[i].offset_m;
     run.anchor_error_m += error.norm() / n;
     run.offset_error_m += std::abs(offset_error) / n;
+    run.reported_sigma_m += w.anchor_sigma.norm() / n;
     run.normalised_sq_sum += error.cwiseQuotient(w.anchor_sigma).squaredNorm() + std::pow(offset_error / w.offset_sigma_m, 2);
     run.normalised_count += 4;
   }
@@ -69,6 +75,8 @@ Summary summarise(const std::vector<RunResult>& runs) {
   double sq = 0.0, iterations = 0.0;
   int count = 0;
   for (const RunResult& r : runs) {
+    if (r.ok) s.mean_reported_sigma_m += r.reported_sigma_m;
+    s.mean_straight_bound_m += r.straight_bound_m / static_cast<double>(runs.size());
     anchors.push_back(r.anchor_error_m);
     offsets.push_back(r.offset_error_m);
     if (!r.ok) ++s.failures;
@@ -79,6 +87,8 @@ Summary summarise(const std::vector<RunResult>& runs) {
   s.anchor = distribution(anchors);
   s.offset = distribution(offsets);
   s.normalised_rms = count ? std::sqrt(sq / count) : 0.0;
+  const int successes = s.runs - s.failures;
+  s.mean_reported_sigma_m = successes ? s.mean_reported_sigma_m / successes : 0.0;
   s.mean_iterations = runs.empty() ? 0.0 : iterations / runs.size();
   return s;
 }

@@ -34,6 +34,10 @@ struct RunResult {
   double normalised_sq_sum = 0.0;  // sum of (error / sigma)^2 over anchor axes and offsets
   int normalised_count = 0;
   int iterations = 0;
+  // What the information allows, each a mean over cables of the anchor's
+  // sigma norm sqrt(sx^2 + sy^2 + sz^2) (the RMS of |a - a_true|):
+  double reported_sigma_m = 0.0;  // from the fit's own covariance (0 when it failed)
+  double straight_bound_m = 0.0;  // Cramer-Rao, straight cables, true robot and poses (solver/pose_design.h)
 };
 
 RunResult run_case(const Case& c, std::uint64_t seed);
@@ -48,6 +52,8 @@ struct Summary {
   int failures = 0;
   Distribution anchor, offset;
   double normalised_rms = 0.0;  // over the successful runs
+  double mean_reported_sigma_m = 0.0;  // over the successful runs
+  double mean_straight_bound_m = 0.0;
   double mean_iterations = 0.0;
 };
 Summary summarise(const std::vector<RunResult>& runs);

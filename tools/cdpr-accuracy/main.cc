@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   double perturbation = -1.0;
   std::vector<double> workspace;
   int design_candidates = 0;
+  double noise_scale = 1.0;
   bool model_check_only = false, verbose = false;
   app.add_option("--preset", preset_name, "large | small")->check(CLI::IsMember({"large", "small"}))->capture_default_str();
   app.add_option("--poses", poses, "static poses per data set")->capture_default_str();
@@ -35,7 +36,11 @@ int main(int argc, char** argv) {
       ->delimiter(',')->expected(6);
   app.add_option("--design", design_candidates,
                  "0: poses spread evenly over the box; N: the most informative of N feasible candidates "
-                 "(D-optimal on the nominal anchors, solver/pose_design.h)")
+                 "(A-optimal on the nominal anchors, solver/pose_design.h)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--noise-scale", noise_scale,
+                 "multiplies the preset's sensor noise; 0 = noiseless data fitted with the preset's sigmas, so the "
+                 "reported sigmas are the model's Cramer-Rao bound for these poses")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_flag("--model-check", model_check_only, "only run the Table I model check");
   app.add_flag("-v,--verbose", verbose, "one line per run");
@@ -65,6 +70,7 @@ int main(int argc, char** argv) {
     c.workspace_max = Eigen::Vector3d(workspace[3], workspace[4], workspace[5]);
   }
   c.design_candidates = design_candidates;
+  c.noise_scale = noise_scale;
   std::vector<cdpr::CableModelKind> models;
   if (model != "rigid") models.push_back(cdpr::CableModelKind::kCatenary);
   if (model != "catenary") models.push_back(cdpr::CableModelKind::kRigid);
@@ -92,6 +98,8 @@ int main(int argc, char** argv) {
     print_row("pulley error [m]", s.anchor);
     print_row("|offset error| [m]", s.offset);
     std::printf("  normalised error RMS (error/sigma): %.2f\n", s.normalised_rms);
+    std::printf("  anchor sigma norm, mean [m]: reported by the fit %.4f, straight-cable Cramer-Rao bound %.4f\n",
+                s.mean_reported_sigma_m, s.mean_straight_bound_m);
   }
   return 0;
 }
