@@ -40,7 +40,7 @@ struct DatasetConfig {
   // Pose design. 0: the first pose_count feasible candidates of the waypoint
   // sequence (an even spread). N > 0: N feasible candidates, of which the
   // pose_count most informative about anchors and offsets are measured
-  // (solver/pose_design.h, D-optimal, judged with the NOMINAL anchors as a
+  // (solver/pose_design.h, A-optimal, judged with the NOMINAL anchors as a
   // planner must).
   int design_candidates = 0;
   int segments = 2000;                // sim/cable_shooting.h
