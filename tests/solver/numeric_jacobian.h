@@ -38,36 +38,62 @@ inline std::vector<double> perturbed(const TestVariable& v, int j, double h) {
   return out;
 }
 
+// The factor evaluated at the variables' values, with its analytic Jacobian
+// blocks (row-major, m x tangent_dim each).
+struct AnalyticEvaluation {
+  std::vector<const double*> parameters;
+  std::vector<std::vector<double>> jacobians;
+  std::vector<double> residual;
+  double cost = 0.0;
+  bool ok = false;
+
+  AnalyticEvaluation(const Factor& factor, const std::vector<TestVariable>& vars)
+      : jacobians(vars.size()), residual(factor.residual_dim()) {
+    const int m = factor.residual_dim();
+    std::vector<double*> blocks;
+    for (std::size_t b = 0; b < vars.size(); ++b) {
+      parameters.push_back(vars[b].ambient.data());
+      jacobians[b].assign(m * vars[b].tangent_dim(), 0.0);
+      blocks.push_back(jacobians[b].data());
+    }
+    ok = factor.evaluate(parameters.data(), residual.data(), blocks.data(), &cost);
+  }
+
+  Eigen::MatrixXd jacobian(std::size_t b) const {
+    const int m = static_cast<int>(residual.size());
+    const int n = static_cast<int>(jacobians[b].size()) / m;
+    return Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+        jacobians[b].data(), m, n);
+  }
+};
+
+// Residual and cost with variable b's tangent coordinate j moved by h.
+inline bool evaluate_perturbed(const Factor& factor, const std::vector<TestVariable>& vars,
+                               std::vector<const double*> parameters, std::size_t b, int j, double h,
+                               std::vector<double>& residual, double& cost) {
+  const std::vector<double> moved = perturbed(vars[b], j, h);
+  parameters[b] = moved.data();
+  return factor.evaluate(parameters.data(), residual.data(), nullptr, &cost);
+}
+
 // Compares analytic and numeric Jacobians block by block; `tolerance` is
 // relative to the largest entry of each block (plus an absolute floor).
 inline void expect_jacobians_match(const Factor& factor, const std::vector<TestVariable>& vars, double step,
                                    double tolerance) {
+  const AnalyticEvaluation at(factor, vars);
+  ASSERT_TRUE(at.ok);
   const int m = factor.residual_dim();
-  std::vector<const double*> params;
-  for (const auto& v : vars) params.push_back(v.ambient.data());
-  std::vector<std::vector<double>> analytic(vars.size());
-  std::vector<double*> jac_ptrs;
-  for (std::size_t b = 0; b < vars.size(); ++b) {
-    analytic[b].assign(m * vars[b].tangent_dim(), 0.0);
-    jac_ptrs.push_back(analytic[b].data());
-  }
-  std::vector<double> residual(m), plus(m), minus(m);
+  std::vector<double> plus(m), minus(m);
   double cost = 0.0;
-  ASSERT_TRUE(factor.evaluate(params.data(), residual.data(), jac_ptrs.data(), &cost));
   for (std::size_t b = 0; b < vars.size(); ++b) {
     const int n = vars[b].tangent_dim();
     Eigen::MatrixXd numeric(m, n);
     for (int j = 0; j < n; ++j) {
-      const std::vector<double> vp = perturbed(vars[b], j, step), vm = perturbed(vars[b], j, -step);
-      std::vector<const double*> pp = params, pm = params;
-      pp[b] = vp.data();
-      pm[b] = vm.data();
-      ASSERT_TRUE(factor.evaluate(pp.data(), plus.data(), nullptr, &cost));
-      ASSERT_TRUE(factor.evaluate(pm.data(), minus.data(), nullptr, &cost));
+      ASSERT_TRUE(evaluate_perturbed(factor, vars, at.parameters, b, j, step, plus, cost));
+      ASSERT_TRUE(evaluate_perturbed(factor, vars, at.parameters, b, j, -step, minus, cost));
       for (int r = 0; r < m; ++r) numeric(r, j) = (plus[r] - minus[r]) / (2.0 * step);
     }
-    const Eigen::MatrixXd exact = Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-        analytic[b].data(), m, n);
+    const Eigen::MatrixXd exact = at.jacobian(b);
     const double scale = std::max(1.0, numeric.cwiseAbs().maxCoeff());
     EXPECT_LE((exact - numeric).cwiseAbs().maxCoeff(), tolerance * scale)
         << "block " << b << "\nanalytic:\n" << exact << "\nnumeric:\n" << numeric;
@@ -79,31 +105,16 @@ inline void expect_jacobians_match(const Factor& factor, const std::vector<TestV
 // is that J^T r is the gradient of the robust cost.
 inline void expect_gradient_matches_cost(const Factor& factor, const std::vector<TestVariable>& vars, double step,
                                          double tolerance) {
-  const int m = factor.residual_dim();
-  std::vector<const double*> params;
-  for (const auto& v : vars) params.push_back(v.ambient.data());
-  std::vector<std::vector<double>> analytic(vars.size());
-  std::vector<double*> jac_ptrs;
+  const AnalyticEvaluation at(factor, vars);
+  ASSERT_TRUE(at.ok);
+  std::vector<double> scratch(factor.residual_dim());
+  double cost_plus = 0.0, cost_minus = 0.0;
+  const Eigen::Map<const Eigen::VectorXd> r(at.residual.data(), factor.residual_dim());
   for (std::size_t b = 0; b < vars.size(); ++b) {
-    analytic[b].assign(m * vars[b].tangent_dim(), 0.0);
-    jac_ptrs.push_back(analytic[b].data());
-  }
-  std::vector<double> residual(m), scratch(m);
-  double cost = 0.0, cost_plus = 0.0, cost_minus = 0.0;
-  ASSERT_TRUE(factor.evaluate(params.data(), residual.data(), jac_ptrs.data(), &cost));
-  const Eigen::Map<const Eigen::VectorXd> r(residual.data(), m);
-  for (std::size_t b = 0; b < vars.size(); ++b) {
-    const int n = vars[b].tangent_dim();
-    const Eigen::MatrixXd J = Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-        analytic[b].data(), m, n);
-    const Eigen::VectorXd gradient = J.transpose() * r;
-    for (int j = 0; j < n; ++j) {
-      const std::vector<double> vp = perturbed(vars[b], j, step), vm = perturbed(vars[b], j, -step);
-      std::vector<const double*> pp = params, pm = params;
-      pp[b] = vp.data();
-      pm[b] = vm.data();
-      ASSERT_TRUE(factor.evaluate(pp.data(), scratch.data(), nullptr, &cost_plus));
-      ASSERT_TRUE(factor.evaluate(pm.data(), scratch.data(), nullptr, &cost_minus));
+    const Eigen::VectorXd gradient = at.jacobian(b).transpose() * r;
+    for (int j = 0; j < vars[b].tangent_dim(); ++j) {
+      ASSERT_TRUE(evaluate_perturbed(factor, vars, at.parameters, b, j, step, scratch, cost_plus));
+      ASSERT_TRUE(evaluate_perturbed(factor, vars, at.parameters, b, j, -step, scratch, cost_minus));
       const double numeric = (cost_plus - cost_minus) / (2.0 * step);
       EXPECT_NEAR(gradient(j), numeric, tolerance * std::max(1.0, std::abs(numeric))) << "block " << b << " column " << j;
     }
