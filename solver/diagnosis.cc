@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <optional>
 
+#include "solver/held_out_comparison.h"
+
 namespace cdpr {
 namespace {
 
@@ -30,26 +32,6 @@ std::string fixed(double value, int digits) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.*f", digits, value);
   return buffer;
-}
-
-bool same_poses(const HeldOutEvaluation& a, const HeldOutEvaluation& b) {
-  if (a.poses.size() != b.poses.size()) return false;
-  for (std::size_t j = 0; j < a.poses.size(); ++j) {
-    if (a.poses[j].sample.id != b.poses[j].sample.id) return false;
-  }
-  return true;
-}
-
-// Mean per-pose chi2 drop from `current` to `candidate` over its standard
-// error; the poses are matched by order (both pool the same folds).
-double paired_t(const HeldOutEvaluation& current, const HeldOutEvaluation& candidate) {
-  const std::size_t n = std::min(current.poses.size(), candidate.poses.size());
-  if (n < 3) return 0.0;
-  double mean = 0.0, square = 0.0;
-  for (std::size_t j = 0; j < n; ++j) mean += (current.poses[j].chi2 - candidate.poses[j].chi2) / n;
-  for (std::size_t j = 0; j < n; ++j) square += std::pow(current.poses[j].chi2 - candidate.poses[j].chi2 - mean, 2);
-  const double standard_error = std::sqrt(square / (n - 1) / n);
-  return standard_error > 0.0 ? mean / standard_error : 0.0;
 }
 
 // Pools one fold's held-out evaluation into the total.
@@ -111,6 +93,66 @@ void report(const DiagnosisOptions& options, const std::string& line) {
   if (options.progress) options.progress(line);
 }
 
+// Why the last `count` effects of a fit on all samples are unphysical, or empty.
+std::string domain_violation(const CalibrationResult& fit, std::size_t count) {
+  if (!fit.ok) return "cannot be fitted to all samples: " + fit.message;
+  for (std::size_t j = fit.effects.size() - count; j < fit.effects.size(); ++j) {
+    const FittedEffect& e = fit.effects[j];
+    const std::string why = effect_domain_violation(e.effect, e.value, e.sigma);
+    if (!why.empty()) return std::string(effect_model_name(e.effect)) + ": " + why;
+  }
+  return {};
+}
+
+struct PairChoice {
+  std::size_t first = 0, second = 0;  // indices into the round's candidates, first with the larger single drop
+  HeldOutEvaluation held_out;
+  CalibrationResult fit;
+  HeldOutComparison against_best;
+  double threshold = 0.0;
+};
+
+// The pair of the round's individually significant candidates (`strong`,
+// best single drop first) that predicts the held-out poses better than the
+// best single candidate (`best_single`) by the largest drop, if that gain is
+// significant at alpha over the number of pairs and both fitted values are
+// physical. Two effects can each be mimicked in part by a third (a cable
+// elasticity and a load-cell bias together look much like a cable density
+// error), and then the greedy single step takes the mimic and neither true
+// effect is significant on top of it.
+std::optional<PairChoice> best_pair(const Robot& robot, const std::vector<Sample>& samples,
+                                    const DiagnosisOptions& options, const std::vector<Effect>& model,
+                                    const std::vector<Effect>& candidates, const std::vector<std::size_t>& strong,
+                                    const HeldOutEvaluation& best_single) {
+  const std::size_t pairs = strong.size() * (strong.size() - 1) / 2;
+  if (pairs == 0) return std::nullopt;
+  const double threshold = normal_upper_quantile(options.alpha / static_cast<double>(pairs));
+  std::optional<PairChoice> best;
+  for (std::size_t a = 0; a < strong.size(); ++a) {
+    for (std::size_t b = a + 1; b < strong.size(); ++b) {
+      std::vector<Effect> with = model;
+      with.push_back(candidates[strong[a]]);
+      with.push_back(candidates[strong[b]]);
+      HeldOutEvaluation f = cross_validate(robot, samples, options, with);
+      if (!f.ok) continue;
+      const HeldOutComparison c = compare_held_out(best_single, f);
+      report(options, "  try pair " + std::string(effect_model_name(with[with.size() - 2])) + " + " +
+                          std::string(effect_model_name(with.back())) + ": held-out chi2 drop " + fixed(c.drop, 1) +
+                          " against the best single, paired t " + fixed(c.t_statistic, 2) + " (needs > " +
+                          fixed(threshold, 2) + ")");
+      if (c.t_statistic <= threshold || 2 * c.paired_poses < static_cast<int>(best_single.poses.size())) continue;
+      if (best && c.drop <= best->against_best.drop) continue;
+      CalibrationResult fit = fit_all(robot, samples, options, with);
+      if (const std::string why = domain_violation(fit, 2); !why.empty()) {
+        report(options, "  reject pair: " + why);
+        continue;
+      }
+      best = PairChoice{strong[a], strong[b], std::move(f), std::move(fit), c, threshold};
+    }
+  }
+  return best;
+}
+
 }  // namespace
 
 double chi_square_upper_tail(double x, int k) {
@@ -162,13 +204,15 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
       score.threshold = normal_upper_quantile(level);
       if (!f.ok) {
         score.failure = f.message;
-      } else if (!same_poses(f, d.steps.back().held_out)) {
-        score.failure = "not comparable: a different number of held-out poses could be evaluated";
+      } else if (const HeldOutComparison c = compare_held_out(d.steps.back().held_out, f);
+                 2 * c.paired_poses < static_cast<int>(d.steps.back().held_out.poses.size())) {
+        score.failure = "not comparable: only " + std::to_string(c.paired_poses) +
+                        " held-out poses could be evaluated under both models";
       } else {
         score.evaluated = true;
         score.held_out_chi2 = f.chi2;
-        score.held_out_drop = d.steps.back().held_out.chi2 - f.chi2;
-        score.t_statistic = paired_t(d.steps.back().held_out, f);
+        score.held_out_drop = c.drop;
+        score.t_statistic = c.t_statistic;
         score.significant = score.t_statistic > score.threshold;
       }
       report(options, "  try " + std::string(effect_model_name(e)) + ": " +
@@ -194,9 +238,7 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
       std::vector<Effect> with = model;
       with.push_back(scores[j].effect);
       CalibrationResult fit = fit_all(robot, samples, options, with);
-      std::string why = fit.ok ? effect_domain_violation(fit.effects.back().effect, fit.effects.back().value,
-                                                         fit.effects.back().sigma)
-                               : "cannot be fitted to all samples: " + fit.message;
+      const std::string why = domain_violation(fit, 1);
       if (why.empty()) {
         best = j;
         best_fit = std::move(fit);
@@ -208,6 +250,41 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
     }
     for (std::size_t j : order) d.steps.back().candidates.push_back(scores[j]);
     if (!best) break;
+
+    if (options.try_pairs && static_cast<int>(d.steps.size()) + 1 <= options.max_added) {
+      std::vector<std::size_t> strong;
+      for (std::size_t j : order) {
+        if (scores[j].evaluated && scores[j].t_statistic > scores[j].threshold && scores[j].failure.empty()) {
+          strong.push_back(j);
+        }
+      }
+      if (std::optional<PairChoice> pair =
+              best_pair(robot, samples, options, model, untried, strong, evaluations[*best])) {
+        // Two steps, so that each effect is named with the misfit it removes.
+        const Effect first = untried[pair->first], second = untried[pair->second];
+        model.push_back(first);
+        report(options, "add pair " + std::string(effect_model_name(first)) + " + " +
+                            std::string(effect_model_name(second)) + ": held-out normalized rms " +
+                            fixed(d.steps.back().held_out.normalized_rms(), 3) + " -> " +
+                            fixed(pair->held_out.normalized_rms(), 3) + " (best single " +
+                            std::string(effect_model_name(scores[*best].effect)) + ": " +
+                            fixed(evaluations[*best].normalized_rms(), 3) + ")");
+        CandidateScore then;
+        then.effect = second;
+        then.evaluated = true;
+        then.held_out_chi2 = pair->held_out.chi2;
+        const HeldOutComparison c = compare_held_out(evaluations[pair->first], pair->held_out);
+        then.held_out_drop = c.drop;
+        then.t_statistic = c.t_statistic;
+        then.threshold = pair->threshold;
+        then.significant = true;
+        d.steps.push_back({model, first, fit_all(robot, samples, options, model), std::move(evaluations[pair->first]),
+                           {then}});
+        model.push_back(second);
+        d.steps.push_back({model, second, std::move(pair->fit), std::move(pair->held_out), {}});
+        continue;
+      }
+    }
 
     model.push_back(scores[*best].effect);
     report(options, "add " + std::string(effect_model_name(scores[*best].effect)) + ": held-out normalized rms " +

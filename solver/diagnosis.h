@@ -9,13 +9,17 @@
 // Evidence is held-out only. Held-out chi2 is a predictive log-likelihood (a
 // term that only fits training noise makes it worse, not better); a
 // candidate is significant when the per-pose drops d_j = chi2_j(current) -
-// chi2_j(with candidate) are positive beyond chance: a paired test
+// chi2_j(with candidate), over the poses both models evaluate
+// (solver/held_out_comparison.h), are positive beyond chance: a paired test
 // (Vuong's, for non-nested predictive likelihoods), mean(d) / (sd(d) / sqrt(n))
 // above the normal quantile at level alpha / m (Bonferroni over the m
 // candidates of the round). The spread of d is measured, not assumed, since
 // cross-validated drops vary more than a chi-square with k dof would. A
 // significant candidate whose fit on all samples leaves its physical range
-// (solver/effects.h effect_domain_violation) is rejected, not added.
+// (solver/effects.h effect_domain_violation) is rejected, not added. Greedy
+// single steps can be led astray when one effect mimics two others together,
+// so a round with a significant candidate also tries pairs of them
+// (DiagnosisOptions::try_pairs).
 // Pure numerics: progress goes through a callback.
 
 #include <functional>
@@ -33,6 +37,11 @@ struct DiagnosisOptions {
   int folds = 3;             // cross-validation: sample k (by order) is held out in fold k % folds
   double alpha = 0.01;       // family-wise significance per round
   int max_added = 4;         // at most this many effects are added
+  // When a round has a significant candidate, also try each pair of its
+  // individually significant candidates, and add a pair instead when it
+  // predicts the held-out poses significantly better than the best single
+  // one (at alpha over the number of pairs).
+  bool try_pairs = true;
   // The held-out misfit counts as unexplained structure when its normalized
   // rms (HeldOutEvaluation) exceeds this and chi2 is significant at `alpha`
   // against its expected value.
@@ -45,7 +54,7 @@ struct CandidateScore {
   bool evaluated = false;      // fitted and evaluated on the held-out poses
   std::string failure;         // why not, when !evaluated
   double held_out_chi2 = 0.0;
-  double held_out_drop = 0.0;  // chi2 of the current model minus chi2 with this effect
+  double held_out_drop = 0.0;  // chi2 of the current model minus chi2 with this effect, on the poses both evaluate
   double t_statistic = 0.0;    // paired: mean per-pose drop over its standard error
   double threshold = 0.0;      // the t that counts as significant
   bool significant = false;

@@ -4,6 +4,7 @@
 // explain when the data hold an effect no model term describes (wind).
 #include "solver/diagnosis.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -49,6 +50,29 @@ TEST(Diagnosis, NamesHiddenElasticityAndRecoversEaWithinThreeSigma) {
   EXPECT_FALSE(d.structure_remains);
   ASSERT_TRUE(d.final_fit.ok);
   EXPECT_EQ(d.final_fit.calibration.model, (std::vector<std::string>{"catenary", "elasticity"}));
+}
+
+TEST(Diagnosis, FindsElasticityAndLoadCellBiasTogetherThoughADensityErrorMimicsBoth) {
+  // GIVEN cables with EA = 1.5e6 N and a load cell reading 15 N high, 90
+  // poses: a 5 % heavier cable alone explains more of that than either true
+  // effect alone, so greedy single steps would name only a density error
+  sim::DatasetConfig config = large_robot(11);
+  config.pose_count = 90;
+  config.effects.axial_stiffness_n = 1.5e6;
+  config.effects.force_bias_n = 15.0;
+  // WHEN the workflow runs
+  const Diagnosis d = run(config);
+  // THEN it adds the pair of true effects, which predicts the held-out poses
+  // better than the mimic, and nothing else
+  ASSERT_EQ(d.steps.size(), 3u);
+  std::vector<Effect> added = {d.steps[1].added, d.steps[2].added};
+  std::sort(added.begin(), added.end());
+  EXPECT_EQ(added, (std::vector<Effect>{Effect::kElasticity, Effect::kLoadCell}));
+  const EffectValues& fitted = d.final_fit.calibration.effects;
+  ASSERT_TRUE(fitted.count("axial_stiffness") && fitted.count("force_bias"));
+  EXPECT_LT(std::abs(fitted.at("axial_stiffness")[0] - 1.5e6), 3.0 * fitted.at("axial_stiffness_sigma")[0]);
+  EXPECT_LT(std::abs(fitted.at("force_bias")[0] - 15.0), 3.0 * fitted.at("force_bias_sigma")[0]);
+  EXPECT_FALSE(d.structure_remains);
 }
 
 TEST(Diagnosis, AddsNothingWhenNothingIsHidden) {
