@@ -51,7 +51,7 @@ bool CalibrationStateMachine::request_start(hal::TimeUs now_us) {
   status_ = CalibrationStatus{};
   status_.started_us = now_us;
   status_.note = "started";
-  enable_sent_ = false;
+  enable_sent_us_.reset();
   previous_.reset();
   plan_ = WaypointPlan{};
   waypoint_index_ = 0;
@@ -106,6 +106,13 @@ void CalibrationStateMachine::step(hal::TimeUs now_us) {
   const CalibrationState state = status_.state;
   if (in_motion_phase(state)) {
     if (std::string fault = monitor_.poll(now_us); !fault.empty()) return fail(fault, now_us, true);
+    if (state == CalibrationState::kPreflight && now_us - status_.state_entered_us < options_.first_contact_timeout_us) {
+      if (std::string missing = monitor_.not_yet_heard(); !missing.empty()) {
+        status_.detail = "waiting for first contact: " + missing;
+        update_progress();
+        return;
+      }
+    }
     const bool drives_enabled = state != CalibrationState::kPreflight;
     if (std::string fault = monitor_.check(now_us, drives_enabled); !fault.empty()) return fail(fault, now_us, true);
   }
@@ -127,7 +134,7 @@ void CalibrationStateMachine::step(hal::TimeUs now_us) {
 }
 
 void CalibrationStateMachine::run_preflight(hal::TimeUs now_us) {
-  if (!enable_sent_) {
+  if (!enable_sent_us_) {
     auto current = devices_.store.load_current();
     if (current) {
       previous_ = std::move(*current);
@@ -136,14 +143,14 @@ void CalibrationStateMachine::run_preflight(hal::TimeUs now_us) {
                      "): calibrating without the change check";
     }
     if (const hal::Status s = devices_.winches.enable(); !s.ok()) return fail("enable: " + s.to_string(), now_us, true);
-    enable_sent_ = true;
+    enable_sent_us_ = now_us;
     status_.detail = "enabling drives";
     return;
   }
   const Readings& readings = monitor_.readings();
   for (int i = 0; i < kCableCount; ++i) {
     if (readings.winches[i].drive != hal::DriveState::kEnabled) {
-      if (now_us - status_.state_entered_us > options_.enable_timeout_us) {
+      if (now_us - *enable_sent_us_ > options_.enable_timeout_us) {
         return fail("winch " + std::to_string(i) + " drive not enabled after " + seconds(options_.enable_timeout_us) +
                         " (" + hal::to_string(readings.winches[i].drive) + ")",
                     now_us, true);

@@ -66,7 +66,11 @@ struct CalibratorOptions {
   std::size_t equilibrium_capacity = 1024;  // >= window x pose rate, with margin
   ValidationLimits validation;
   MonitorLimits monitor;
-  hal::TimeUs enable_timeout_us = 5'000'000;
+  // Preflight waits this long for the first word from every device (a node's
+  // heartbeat, a pose, a load-cell reading) before calling one missing a
+  // fault: a button pressed just after the daemon or a sensor started.
+  hal::TimeUs first_contact_timeout_us = 3'000'000;
+  hal::TimeUs enable_timeout_us = 5'000'000;  // from the enable command
   hal::TimeUs move_timeout_us = 600'000'000;
   hal::TimeUs settle_timeout_us = 60'000'000;
 };
@@ -136,7 +140,7 @@ class CalibrationStateMachine {
 
   CalibrationStatus status_;
   // Per run:
-  bool enable_sent_ = false;
+  std::optional<hal::TimeUs> enable_sent_us_;  // when preflight commanded the drives on
   std::optional<store::CurrentCalibration> previous_;
   WaypointPlan plan_;
   int waypoint_index_ = 0;  // 0-based

@@ -41,6 +41,17 @@ std::string HardwareMonitor::poll(hal::TimeUs now_us) {
   return {};
 }
 
+std::string HardwareMonitor::not_yet_heard() const {
+  std::string missing;
+  const auto add = [&missing](const std::string& what) { missing += (missing.empty() ? "" : ", ") + what; };
+  for (int i = 0; i < kCableCount && i < winches_.winch_count(); ++i) {
+    if (readings_.winches[i].heartbeat_age_us < 0) add("winch " + std::to_string(i) + " node");
+  }
+  if (!readings_.pose) add("pose");
+  if (!readings_.tension) add("load cell");
+  return missing;
+}
+
 std::string HardwareMonitor::check(hal::TimeUs now_us, bool drives_enabled) const {
   if (winches_.winch_count() != kCableCount) {
     return "winch bank has " + std::to_string(winches_.winch_count()) + " winches, robot has 4";

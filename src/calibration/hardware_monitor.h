@@ -50,6 +50,11 @@ class HardwareMonitor {
   // must be in operation enabled, otherwise only a fault is one. Returns a
   // fault reason, empty when safe.
   std::string check(hal::TimeUs now_us, bool drives_enabled) const;
+  // The devices not heard from at all since reset() (a winch node without a
+  // heartbeat yet, no pose, no load-cell reading), as "winch 2 node, pose";
+  // empty when every device has spoken. Right after the daemon or a sensor
+  // starts that is a matter of waiting, not a fault.
+  std::string not_yet_heard() const;
 
   const Readings& readings() const { return readings_; }
   const MonitorLimits& limits() const { return limits_; }

@@ -170,12 +170,14 @@ void read_calibration(TomlReader& reader, ConfigReader& r, const toml::table& ro
   const toml::table& limits = reader.table(root, "limits", "", kOptional);
   const char* p = "limits";
   reader.check_keys(limits, p, {{"min_tension", kOptional}, {"max_tension", kOptional}, {"pose_stale_ms", kOptional},
-                                {"max_consecutive_load_cell_errors", kOptional}, {"enable_timeout_s", kOptional},
+                                {"max_consecutive_load_cell_errors", kOptional}, {"first_contact_timeout_s", kOptional},
+                                {"enable_timeout_s", kOptional},
                                 {"move_timeout_s", kOptional}, {"settle_timeout_s", kOptional}});
   r.number(limits, "min_tension", p, o.monitor.min_tension_n, Bound::kNonNegative);
   r.number(limits, "max_tension", p, o.monitor.max_tension_n, Bound::kPositive);
   r.duration_us(limits, "pose_stale_ms", p, o.monitor.pose_stale_us, 1e3);
   r.integer(limits, "max_consecutive_load_cell_errors", p, o.monitor.max_consecutive_load_cell_errors, 0, 1000);
+  r.duration_us(limits, "first_contact_timeout_s", p, o.first_contact_timeout_us, 1e6);
   r.duration_us(limits, "enable_timeout_s", p, o.enable_timeout_us, 1e6);
   r.duration_us(limits, "move_timeout_s", p, o.move_timeout_us, 1e6);
   r.duration_us(limits, "settle_timeout_s", p, o.settle_timeout_us, 1e6);

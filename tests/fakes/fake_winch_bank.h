@@ -55,6 +55,7 @@ class FakeWinchBank final : public hal::WinchBank {
     });
   }
   int quick_stops() const { return quick_stops_; }
+  int enables() const { return enables_; }  // enable() commands accepted
   int halts() const { return halts_; }
 
   // ---- hal::WinchBank ----
@@ -96,6 +97,7 @@ class FakeWinchBank final : public hal::WinchBank {
   hal::Status enable() override {
     if (hal::Status s = check_command(); !s.ok()) return s;
     for (Winch& w : winches_) w.request = Request::kEnable;
+    ++enables_;
     return hal::Status::Ok();
   }
   hal::Status disable() override {
@@ -220,6 +222,7 @@ class FakeWinchBank final : public hal::WinchBank {
   hal::TimeUs last_update_us_ = -1;
   hal::TimeUs now_us_ = 0;
   int quick_stops_ = 0;
+  int enables_ = 0;
   int halts_ = 0;
   hal::WinchBankCounters counters_;
 };

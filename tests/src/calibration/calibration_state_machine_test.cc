@@ -277,10 +277,39 @@ TEST(CalibrationStateMachine, PreflightRefusesWithoutAPose) {
   // GIVEN a pose source that sends nothing
   CalibrationRig rig;
   rig.pose.set_streaming(false);
-  // WHEN started THEN it fails at once in preflight
+  // WHEN started THEN it fails in preflight once the first-contact wait is over, drives never enabled
   rig.button.press();
   ASSERT_TRUE(rig.run_to_end());
   expect_failed_safely(rig, "pose stale: no pose received (during preflight)");
+  EXPECT_GE(rig.status().finished_us - rig.status().started_us, test::rig_options().first_contact_timeout_us);
+  EXPECT_EQ(rig.winches.enables(), 0);
+}
+
+TEST(CalibrationStateMachine, PreflightWaitsForAPoseThatArrivesLate) {
+  // GIVEN a pose tracker still starting up when the button is pressed
+  CalibrationRig rig;
+  rig.pose.set_streaming(false);
+  rig.button.press();
+  // THEN for a second preflight waits and says for what, without enabling the drives
+  EXPECT_FALSE(rig.run_until([&] { return rig.status().state != CalibrationState::kPreflight; }, 1'000'000));
+  EXPECT_EQ(rig.status().detail, "waiting for first contact: pose");
+  EXPECT_EQ(rig.winches.enables(), 0);
+  // WHEN the poses start to arrive THEN the run goes on to the end
+  rig.pose.set_streaming(true);
+  ASSERT_TRUE(rig.run_to_end());
+  EXPECT_EQ(rig.status().state, CalibrationState::kDone) << rig.status().reason;
+}
+
+TEST(CalibrationStateMachine, ANodeHeardBeforeAndNowSilentIsAFaultAtOnce) {
+  // GIVEN winch 3's node heard at start-up, silent when the button is pressed
+  CalibrationRig rig;
+  ASSERT_TRUE(rig.winches.update(rig.clock.now_us()).ok());
+  rig.winches.silence(3);
+  rig.button.press();
+  // WHEN started THEN preflight does not wait for it: a node that stopped talking is a fault
+  ASSERT_TRUE(rig.run_to_end());
+  expect_failed_safely(rig, "winch 3 node silent (last heard");
+  EXPECT_LT(rig.status().finished_us - rig.status().started_us, test::rig_options().first_contact_timeout_us);
 }
 
 TEST(CalibrationStateMachine, PreflightFailsWhenADriveDoesNotEnable) {

@@ -42,6 +42,8 @@ TEST(DaemonConfig, TheShippedExampleParsesToTheDefaults) {
   EXPECT_EQ(p.z_max_m, defaults.calibrator.planner.z_max_m);
   EXPECT_EQ(p.max_tension_n, defaults.calibrator.planner.max_tension_n);
   EXPECT_EQ(config->calibrator.settle_timeout_us, defaults.calibrator.settle_timeout_us);
+  EXPECT_EQ(config->calibrator.first_contact_timeout_us, defaults.calibrator.first_contact_timeout_us);
+  EXPECT_EQ(config->calibrator.enable_timeout_us, defaults.calibrator.enable_timeout_us);
   EXPECT_EQ(config->calibrator.equilibrium.window_us, defaults.calibrator.equilibrium.window_us);
   EXPECT_EQ(config->calibrator.validation.max_anchor_change_m, defaults.calibrator.validation.max_anchor_change_m);
   EXPECT_EQ(config->solver.max_iterations, defaults.solver.max_iterations);
@@ -62,6 +64,8 @@ word_order = "low_word_first"
 kind = "none"
 [equilibrium]
 window_s = 1.5
+[limits]
+first_contact_timeout_s = 0.5
 [validation]
 accept_max_iterations = true
 )";
@@ -75,6 +79,7 @@ accept_max_iterations = true
   EXPECT_TRUE(config->load_cell.low_word_first);
   EXPECT_FALSE(config->button.gpio);
   EXPECT_EQ(config->calibrator.equilibrium.window_us, 1'500'000);
+  EXPECT_EQ(config->calibrator.first_contact_timeout_us, 500'000);
   EXPECT_TRUE(config->calibrator.validation.accept_max_iterations);
 }
 
