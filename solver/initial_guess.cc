@@ -85,6 +85,42 @@ std::optional<ReferenceForceMap> force_map(const Robot& robot, const std::array<
   return map;
 }
 
+// Damped Gauss-Newton on the fit's residuals over N unknowns x: Levenberg's
+// damping of the normal matrix's diagonal, ten times more after a failed
+// trial, ten times less after a success; at most 50 trials. `evaluate(x,
+// residual, jacobian)` is false outside the model; `propose(x, H, g)` gives
+// the trial point from the damped normal matrix H and gradient g. False
+// when the start x cannot be evaluated; else x is the best point found.
+template <int N, typename Evaluate, typename Propose>
+bool damped_gauss_newton(Eigen::Matrix<double, N, 1>& x, const Evaluate& evaluate, const Propose& propose) {
+  using Vector = Eigen::Matrix<double, N, 1>;
+  using Jacobian = Eigen::Matrix<double, kFitRows, N>;
+  FitResiduals residual, trial_residual;
+  Jacobian jacobian, trial_jacobian;
+  if (!evaluate(x, residual, jacobian)) return false;
+  double cost = residual.squaredNorm();
+  double damping = 1e-3;
+  for (int iteration = 0; iteration < 50 && damping < 1e12; ++iteration) {
+    const Vector gradient = jacobian.transpose() * residual;
+    Eigen::Matrix<double, N, N> H = jacobian.transpose() * jacobian;
+    H.diagonal() *= 1.0 + damping;
+    const Vector trial = propose(x, H, gradient);
+    if (evaluate(trial, trial_residual, trial_jacobian) && trial_residual.squaredNorm() < cost) {
+      const double trial_cost = trial_residual.squaredNorm();
+      const bool converged = cost - trial_cost < 1e-12 * (1.0 + cost);
+      x = trial;
+      residual = trial_residual;
+      jacobian = trial_jacobian;
+      cost = trial_cost;
+      damping = std::max(damping / 10.0, 1e-9);
+      if (converged) break;
+    } else {
+      damping *= 10.0;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 std::optional<Eigen::Vector2d> refine_reference_force(const Robot& robot,
@@ -96,31 +132,15 @@ std::optional<Eigen::Vector2d> refine_reference_force(const Robot& robot,
   // statics are factorised once and each trial costs four catenaries.
   const std::optional<ReferenceForceMap> map = force_map(robot, anchors, sample);
   if (!map) return std::nullopt;
+  auto evaluate = [&](const Eigen::Vector2d& force, FitResiduals& residual, FitJacobian& jacobian) {
+    return height_and_force(robot, *map, sample, force, sigma_height_m, residual, &jacobian);
+  };
   Eigen::Vector2d force = guess;
-  FitResiduals residual, trial_residual;
-  FitJacobian jacobian, trial_jacobian;
-  if (!height_and_force(robot, *map, sample, force, sigma_height_m, residual, &jacobian)) return std::nullopt;
-  double cost = residual.squaredNorm();
-  double damping = 1e-3;
-  for (int iteration = 0; iteration < 50 && damping < 1e12; ++iteration) {
-    const Eigen::Vector2d gradient = jacobian.transpose() * residual;
-    Eigen::Matrix2d H = jacobian.transpose() * jacobian;
-    H.diagonal() *= 1.0 + damping;
-    const Eigen::Vector2d trial = force - H.ldlt().solve(gradient);
-    if (height_and_force(robot, *map, sample, trial, sigma_height_m, trial_residual, &trial_jacobian) &&
-        trial_residual.squaredNorm() < cost) {
-      const double trial_cost = trial_residual.squaredNorm();
-      const bool converged = cost - trial_cost < 1e-12 * (1.0 + cost);
-      force = trial;
-      residual = trial_residual;
-      jacobian = trial_jacobian;
-      cost = trial_cost;
-      damping = std::max(damping / 10.0, 1e-9);
-      if (converged) break;
-    } else {
-      damping *= 10.0;
-    }
-  }
+  const bool evaluable = damped_gauss_newton<2>(
+      force, evaluate, [](const Eigen::Vector2d& x, const Eigen::Matrix2d& H, const Eigen::Vector2d& gradient) {
+        return Eigen::Vector2d(x - H.ldlt().solve(gradient));
+      });
+  if (!evaluable) return std::nullopt;
   return force;
 }
 
@@ -184,41 +204,25 @@ std::optional<ForceAndHeading> refine_reference_force_and_heading(
     if (tension > 0.0) jacobian.block<1, 2>(kCableCount, 0) = force.transpose() / (tension * sigma_force);
     return true;
   };
-  Eigen::Vector2d force = guess;
-  double yaw = std::clamp(yaw_guess_rad, yaw_min_rad, yaw_max_rad);
-  FitResiduals residual, trial_residual;
-  Jacobian3 jacobian, trial_jacobian;
-  if (!evaluate(force, yaw, residual, jacobian)) return std::nullopt;
-  double cost = residual.squaredNorm();
-  double damping = 1e-3;
-  for (int iteration = 0; iteration < 50 && damping < 1e12; ++iteration) {
-    const Eigen::Vector3d gradient = jacobian.transpose() * residual;
-    Eigen::Matrix3d H = jacobian.transpose() * jacobian;
-    H.diagonal() *= 1.0 + damping;
+  // The unknowns as one vector (f_h, f_v, yaw).
+  auto evaluate_at = [&](const Eigen::Vector3d& x, FitResiduals& residual, Jacobian3& jacobian) {
+    return evaluate(x.head<2>(), x(2), residual, jacobian);
+  };
+  Eigen::Vector3d x(guess.x(), guess.y(), std::clamp(yaw_guess_rad, yaw_min_rad, yaw_max_rad));
+  auto propose = [&](const Eigen::Vector3d& current, const Eigen::Matrix3d& H, const Eigen::Vector3d& gradient) {
     Eigen::Vector3d step = -H.ldlt().solve(gradient);
+    const double yaw = current(2);
     // At a bound the cost wants to cross, the heading stays there and the
     // step is taken in the forces alone (a projected Gauss-Newton step).
     if ((yaw <= yaw_min_rad && step(2) < 0.0) || (yaw >= yaw_max_rad && step(2) > 0.0)) {
       step.head<2>() = -H.topLeftCorner<2, 2>().ldlt().solve(gradient.head<2>());
       step(2) = 0.0;
     }
-    const Eigen::Vector2d trial_force = force + step.head<2>();
-    const double trial_yaw = std::clamp(yaw + step(2), yaw_min_rad, yaw_max_rad);
-    if (evaluate(trial_force, trial_yaw, trial_residual, trial_jacobian) && trial_residual.squaredNorm() < cost) {
-      const double trial_cost = trial_residual.squaredNorm();
-      const bool converged = cost - trial_cost < 1e-12 * (1.0 + cost);
-      force = trial_force;
-      yaw = trial_yaw;
-      residual = trial_residual;
-      jacobian = trial_jacobian;
-      cost = trial_cost;
-      damping = std::max(damping / 10.0, 1e-9);
-      if (converged) break;
-    } else {
-      damping *= 10.0;
-    }
-  }
-  return ForceAndHeading{force, yaw};
+    return Eigen::Vector3d(current(0) + step(0), current(1) + step(1),
+                           std::clamp(yaw + step(2), yaw_min_rad, yaw_max_rad));
+  };
+  if (!damped_gauss_newton<3>(x, evaluate_at, propose)) return std::nullopt;
+  return ForceAndHeading{x.head<2>(), x(2)};
 }
 
 std::array<double, kCableCount> mean_offsets(const std::vector<Sample>& samples,

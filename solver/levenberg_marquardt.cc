@@ -108,7 +108,7 @@ class FullSystem final : public LinearSystem {
   std::vector<double> jtj_, damped_, product_;
 };
 
-// Per-pose blocks eliminated first, CHOLMOD on the reduced system over the
+// Per-pose blocks eliminated first, dense Cholesky of the reduced system over the
 // global variables (solver/schur_complement.h): calibration problems.
 class ReducedSystem final : public LinearSystem {
  public:

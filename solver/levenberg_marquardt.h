@@ -5,9 +5,9 @@
 // symbolic Cholesky analysis (SparseCholesky) and every scratch buffer, in
 // time linear in the problem's size. When no factor couples two poses' own
 // variables (the calibration graph), the per-pose blocks are eliminated
-// first and CHOLMOD factorises only the reduced system over the global
-// variables (anchors, offsets, model terms), so an iteration costs O(poses);
-// otherwise CHOLMOD factorises the whole J^T J.
+// first and only the small reduced system over the global variables
+// (anchors, offsets, model terms) is factorised, densely, so an iteration
+// costs O(poses); otherwise CHOLMOD factorises the whole J^T J.
 // solve() then allocates nothing per iteration (checked by a test that
 // counts heap allocations). The problem's structure must not change while
 // a solver refers to it; values may (solve() starts from the current ones).
@@ -49,8 +49,8 @@ struct SolverOptions {
   double initial_trust_radius = 1e4;
   double max_trust_radius = 1e16;
   double min_trust_radius = 1e-32;
-  // Eliminate the per-pose variables first (Schur complement, CHOLMOD on the
-  // reduced system over the global ones) when no factor couples two poses;
+  // Eliminate the per-pose variables first (Schur complement, dense Cholesky
+  // of the reduced system over the global ones) when no factor couples two poses;
   // false: always factorise the whole J^T J.
   bool eliminate_poses = true;
   // Called with iteration 0 (the initial point) and then once per iteration,
@@ -82,7 +82,7 @@ class SparseCholesky;
 
 enum class LinearSystemKind {
   kFull,             // the whole J^T J in CHOLMOD (AMD order)
-  kPosesEliminated,  // per-pose blocks eliminated, CHOLMOD on the global variables (solver/schur_complement.h)
+  kPosesEliminated,  // per-pose blocks eliminated, dense Cholesky on the global variables (solver/schur_complement.h)
 };
 
 class LevenbergMarquardt {

@@ -78,4 +78,18 @@ bool Linearization::evaluate(const double* state, int slot, double* cost, int* f
   return true;
 }
 
+void Linearization::add_gradient(int slot, int f, double* gradient) const {
+  const int m = residual_dim(f);
+  const double* residual = residuals(slot, f);
+  for (int k = 0; k < key_count(f); ++k) {
+    const int column = key_column(f, k);
+    if (column < 0) continue;
+    const int d = key_dim(f, k);
+    const double* J = jacobian(slot, f, k);
+    for (int i = 0; i < m; ++i) {
+      for (int c = 0; c < d; ++c) gradient[column + c] += J[i * d + c] * residual[i];
+    }
+  }
+}
+
 }  // namespace cdpr

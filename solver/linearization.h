@@ -47,6 +47,10 @@ class Linearization {
     return jacobian_pointers_[slot][layout_[f].key_offset + k];
   }
 
+  // gradient[column of each non-constant key] += J_k' r of factor f in
+  // `slot`: that factor's share of J^T r, in the caller's column layout.
+  void add_gradient(int slot, int f, double* gradient) const;
+
  private:
   struct FactorLayout {
     int residual_offset;  // into a slot's residuals

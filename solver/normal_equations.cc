@@ -134,17 +134,7 @@ void NormalEquations::accumulate(int slot, double* jtj, double* gradient) const 
   const Linearization& lin = linearization_;
   for (int f = 0; f < lin.factor_count(); ++f) {
     const int m = lin.residual_dim(f);
-    const double* residual = lin.residuals(slot, f);
-    const int nk = lin.key_count(f);
-    for (int k = 0; k < nk; ++k) {
-      const int column = lin.key_column(f, k);
-      if (column < 0) continue;
-      const int d = lin.key_dim(f, k);
-      const double* J = lin.jacobian(slot, f, k);
-      for (int i = 0; i < m; ++i) {
-        for (int c = 0; c < d; ++c) gradient[column + c] += J[i * d + c] * residual[i];
-      }
-    }
+    lin.add_gradient(slot, f, gradient);
     for (int b = block_begin_[f]; b < block_begin_[f + 1]; ++b) {
       const BlockRef& block = blocks_[b];
       const int dr = lin.key_dim(f, block.row_key), dc = lin.key_dim(f, block.column_key);

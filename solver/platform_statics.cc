@@ -12,7 +12,15 @@ const Eigen::Vector3d kUp = Eigen::Vector3d::UnitZ();
 
 Eigen::Matrix3d skew3(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  m(0, 0) = 0.0;
+  m(0, 1) = -v.z();
+  m(0, 2) = v.y();
+  m(1, 0) = v.z();
+  m(1, 1) = 0.0;
+  m(1, 2) = -v.x();
+  m(2, 0) = -v.y();
+  m(2, 1) = v.x();
+  m(2, 2) = 0.0;
   return m;
 }
 
@@ -24,14 +32,19 @@ struct CableGeometry {
 };
 
 // Wrench columns of J^T for one cable, Eq. (8): f_h acts along -s_c, f_v along +z.
+// (Fixed-size segments, not Eigen's comma initializer: these run for every
+// statics evaluation, and the initializer's runtime bookkeeping cost more
+// than the arithmetic.)
 Wrench column_h(const CableGeometry& g) {
   Wrench c;
-  c << -g.s_c, -g.lever_world.cross(g.s_c);
+  c.head<3>() = -g.s_c;
+  c.tail<3>() = -g.lever_world.cross(g.s_c);
   return c;
 }
 Wrench column_v(const CableGeometry& g) {
   Wrench c;
-  c << kUp, g.lever_world.cross(kUp);
+  c.head<3>() = kUp;
+  c.tail<3>() = g.lever_world.cross(kUp);
   return c;
 }
 
@@ -89,9 +102,7 @@ class Lu6 {
       for (int c = r + 1; c < 6; ++c) sum -= lu_[r][c] * x[c];
       x[r] = sum * inverse_diagonal_[r];
     }
-    Wrench out;
-    out << x[0], x[1], x[2], x[3], x[4], x[5];
-    return out;
+    return Eigen::Map<const Wrench>(x);
   }
 
  private:
@@ -134,7 +145,8 @@ StaticsStatus set_up(const Robot& robot, const StaticsInput& in, Setup& s,
   const double weight_n = robot.platform_mass_kg * robot.gravity_mps2;
   s.com_platform = robot.center_of_mass_platform + in.com_offset_platform;
   const Eigen::Vector3d com_world = s.R * s.com_platform;
-  s.w << weight_n * kUp, weight_n * com_world.cross(kUp);
+  s.w.head<3>() = weight_n * kUp;
+  s.w.tail<3>() = weight_n * com_world.cross(kUp);
 
   // Eq. (9)-(11): partition J^T into the reference cable and the rest.
   const int ref = robot.reference_cable;
@@ -275,9 +287,13 @@ StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in,
     const Eigen::Vector3d t(-g.s_c.y(), g.s_c.x(), 0.0);
     const double f_h = cables[i].f_h;
     const Eigen::Vector3d force = -f_h * g.s_c + cables[i].f_v * kUp;
-    phi[i] << t.x() / g.span, t.y() / g.span, (t.transpose() * d_lever[i]) / g.span, -t.x() / g.span,
-        -t.y() / g.span;
-    e.col(kU + i) << f_h * t, f_h * g.lever_world.cross(t);
+    phi[i](0) = t.x() / g.span;
+    phi[i](1) = t.y() / g.span;
+    phi[i].segment<3>(2) = (t.transpose() * d_lever[i]) / g.span;
+    phi[i](5) = -t.x() / g.span;
+    phi[i](6) = -t.y() / g.span;
+    e.col(kU + i).head<3>() = f_h * t;
+    e.col(kU + i).tail<3>() = f_h * g.lever_world.cross(t);
     e.block<3, 3>(3, kRotation) += skew3(force) * d_lever[i];
   }
   e.block<3, 3>(3, kCom) = -weight_n * skew3(kUp) * R;

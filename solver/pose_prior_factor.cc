@@ -21,7 +21,8 @@ bool PosePriorFactor::evaluate(const double* const* parameters, double* residual
   const Eigen::Vector3d dp = (pose.position_world - measured_.position_world) / sigma_position_m_;
   const Eigen::Vector3d rotation_error = so3_log(measured_.world_R_platform.conjugate() * pose.world_R_platform);
   Eigen::Map<Eigen::Matrix<double, 6, 1>> r(residual);
-  r << dp, rotation_error / sigma_orientation_rad_;
+  r.head<3>() = dp;
+  r.tail<3>() = rotation_error / sigma_orientation_rad_;
   if (jacobians && jacobians[0]) {
     Eigen::Map<Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> J(jacobians[0]);
     J.setZero();

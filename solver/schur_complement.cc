@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 #include <unordered_map>
 
 #include <Eigen/Core>
@@ -86,16 +87,21 @@ bool eliminate_group(int dim, const double* a, double* u, const double* b, doubl
     for (int p = 0; p < i; ++p) wi -= u[p + d * i] * ConstRow(w + p * m, m);
     wi /= u[i + d * i];
   }
-  // S -= sum_i w_i w_i' (upper triangle).
+  // S -= W'W (upper triangle).
+  if (first >= 0) {
+    // Contiguous columns: one symmetric rank-d update of S's block, which
+    // Eigen blocks and vectorises (its scratch lives on the stack).
+    using WMatrix = Eigen::Matrix<double, (D > 0 ? D : Eigen::Dynamic), Eigen::Dynamic, Eigen::RowMajor>;
+    Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> s_block(s + first + static_cast<std::size_t>(n) * first, m, m,
+                                                                 Eigen::OuterStride<>(n));
+    s_block.selfadjointView<Eigen::Upper>().rankUpdate(Eigen::Map<const WMatrix>(w, d, m).transpose(), -1.0);
+    return true;
+  }
   for (int i = 0; i < d; ++i) {
     const double* wi = w + i * m;
     for (int q = 0; q < m; ++q) {
-      if (first >= 0) {
-        Row(s + first + static_cast<std::size_t>(n) * (first + q), q + 1) -= wi[q] * ConstRow(wi, q + 1);
-      } else {
-        double* s_column = s + static_cast<std::size_t>(n) * columns[q];
-        for (int p = 0; p <= q; ++p) s_column[columns[p]] -= wi[p] * wi[q];
-      }
+      double* s_column = s + static_cast<std::size_t>(n) * columns[q];
+      for (int p = 0; p <= q; ++p) s_column[columns[p]] -= wi[p] * wi[q];
     }
   }
   return true;
@@ -123,6 +129,18 @@ void backward_group(int dim, const double* u, const double* w, int m, const int*
     y[i] -= dot;
   }
   solve_upper<D>(u, d, y);
+}
+
+// Calls f(std::integral_constant<int, D>) with D the group size when the
+// kernels above are compiled for it (a pose with its reference force: 8; a
+// pose alone: 6), else D = 0 (runtime size).
+template <typename F>
+void for_group_dim(int dim, F&& f) {
+  switch (dim) {
+    case 8: f(std::integral_constant<int, 8>{}); break;
+    case 6: f(std::integral_constant<int, 6>{}); break;
+    default: f(std::integral_constant<int, 0>{});
+  }
 }
 
 // out(r, c) += sum_i Ja(i, r) Jb(i, c), Ja and Jb row-major m x da and
@@ -343,53 +361,6 @@ SchurComplement::SchurComplement(const Problem& problem, std::vector<int> variab
     }
   }
   op_begin_.push_back(static_cast<int>(ops_.size()));
-
-  // Pattern of S over the global variables: a block for every pair of
-  // global variables one group couples to or one factor names, and the
-  // diagonal blocks.
-  std::vector<int> global_variables;
-  for (int v = 0; v < nv; ++v) {
-    if (group_of[v] < 0 && column_of(v) >= 0) global_variables.push_back(v);
-  }
-  std::sort(global_variables.begin(), global_variables.end(),
-            [&](int x, int y) { return column_of(x) < column_of(y); });
-  std::vector<std::vector<int>> block_rows(nv);
-  auto add_pair = [&](int x, int y) {
-    if (column_of(x) > column_of(y)) std::swap(x, y);
-    block_rows[y].push_back(x);
-  };
-  for (int v : global_variables) add_pair(v, v);
-  for (int g = 0; g < group_count; ++g) {
-    const std::vector<int>& list = coupled_variables[g];
-    // Neighbouring groups usually reach the same globals: skip repeats.
-    if (g > 0 && list == coupled_variables[g - 1]) continue;
-    for (std::size_t q = 0; q < list.size(); ++q) {
-      for (std::size_t p = 0; p < q; ++p) add_pair(list[p], list[q]);
-    }
-  }
-  for (int f = 0; f < nf; ++f) {
-    for (int op = op_begin_[f]; op < op_begin_[f + 1]; ++op) {
-      if (ops_[op].target != kGlobal) continue;
-      add_pair(linearization_.key_variable(f, ops_[op].a), linearization_.key_variable(f, ops_[op].b));
-    }
-  }
-  s_starts_.assign(n + 1, 0);
-  for (int v : global_variables) {
-    std::vector<int>& rows = block_rows[v];
-    std::sort(rows.begin(), rows.end(), [&](int x, int y) { return column_of(x) < column_of(y); });
-    rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
-    for (int d = 0; d < variables[v].tangent_dim; ++d) {
-      const int c = global_column(v) + d;
-      for (int r : rows) {
-        const int first = global_column(r);
-        const int last = r == v ? c : first + variables[r].tangent_dim - 1;
-        for (int row = first; row <= last; ++row) s_rows_.push_back(row);
-      }
-      s_starts_[c + 1] = static_cast<int>(s_rows_.size());
-    }
-  }
-  s_values_.assign(s_rows_.size(), 0.0);
-  cholesky_ = std::make_unique<SparseCholesky>(n, s_starts_, s_rows_);
 }
 
 SchurComplement::~SchurComplement() = default;
@@ -403,16 +374,7 @@ void SchurComplement::accumulate(int slot, double* gradient) {
   double* targets[3] = {a_.data(), b_.data(), c_.data()};
   for (int f = 0; f < lin.factor_count(); ++f) {
     const int m = lin.residual_dim(f);
-    const double* residual = lin.residuals(slot, f);
-    for (int k = 0; k < lin.key_count(f); ++k) {
-      const int column = lin.key_column(f, k);
-      if (column < 0) continue;
-      const int d = lin.key_dim(f, k);
-      const double* J = lin.jacobian(slot, f, k);
-      for (int i = 0; i < m; ++i) {
-        for (int c = 0; c < d; ++c) gradient[column + c] += J[i * d + c] * residual[i];
-      }
-    }
+    lin.add_gradient(slot, f, gradient);
     for (int o = op_begin_[f]; o < op_begin_[f + 1]; ++o) {
       const BlockOp& op = ops_[o];
       const int da = lin.key_dim(f, op.a), db = lin.key_dim(f, op.b);
@@ -440,12 +402,11 @@ FactorizationStatus SchurComplement::factorize(double radius, double min_diagona
     double* w = w_.data() + g.coupling;
     const int* columns = coupled_.data() + g.coupled_begin;
     const int first = g.contiguous ? (m > 0 ? columns[0] : 0) : -1;
-    bool ok;
-    switch (d) {  // the sizes of a pose group: pose + reference force, or a pose alone
-      case 8: ok = eliminate_group<8>(d, a, u, b, w, m, columns, first, s_.data(), n, radius, min_diagonal, max_diagonal); break;
-      case 6: ok = eliminate_group<6>(d, a, u, b, w, m, columns, first, s_.data(), n, radius, min_diagonal, max_diagonal); break;
-      default: ok = eliminate_group<0>(d, a, u, b, w, m, columns, first, s_.data(), n, radius, min_diagonal, max_diagonal);
-    }
+    bool ok = false;
+    for_group_dim(d, [&](auto size) {
+      constexpr int D = decltype(size)::value;
+      ok = eliminate_group<D>(d, a, u, b, w, m, columns, first, s_.data(), n, radius, min_diagonal, max_diagonal);
+    });
     if (!ok) {
       bool finite = true;
       for (int k = 0; k < d * d; ++k) finite = finite && std::isfinite(a[k]);
@@ -456,43 +417,43 @@ FactorizationStatus SchurComplement::factorize(double radius, double min_diagona
       return finite ? FactorizationStatus::kNotPositiveDefinite : FactorizationStatus::kFatal;
     }
   }
-  for (int c = 0; c < n; ++c) {
-    for (int k = s_starts_[c]; k < s_starts_[c + 1]; ++k) {
-      s_values_[k] = s_[s_rows_[k] + static_cast<std::size_t>(n) * c];
+  // S is dense (every pose reaches every global variable it is coupled to,
+  // and the globals are few): an in-place dense Cholesky beats a sparse
+  // factorisation's overhead at this size.
+  for (int k = 0; k < n * n; ++k) {
+    if (!std::isfinite(s_[k])) {
+      if (message) *message = "reduced matrix entry " + std::to_string(k) + " is not finite";
+      return FactorizationStatus::kFatal;
     }
   }
-  return cholesky_->factorize(s_values_.data(), message);
+  if (!cholesky_upper<0>(s_.data(), n)) {
+    if (message) *message = "matrix not positive definite (the reduced system over the global variables)";
+    return FactorizationStatus::kNotPositiveDefinite;
+  }
+  return FactorizationStatus::kSuccess;
 }
 
 void SchurComplement::solve(const double* b, double* x) {
   const int n = global_dim_;
   std::copy(b + local_dim_, b + local_dim_ + n, reduced_rhs_.begin());
-  for (const Group& g : groups_) {
-    const int d = g.dim, m = g.coupled_end - g.coupled_begin;
-    const double* u = factor_.data() + g.block;
-    const double* w = w_.data() + g.coupling;
-    const int* columns = coupled_.data() + g.coupled_begin;
-    double* y = x + g.column;
-    if (x != b) std::copy(b + g.column, b + g.column + d, y);
-    switch (d) {
-      case 8: forward_group<8>(d, u, w, m, columns, y, reduced_rhs_.data()); break;
-      case 6: forward_group<6>(d, u, w, m, columns, y, reduced_rhs_.data()); break;
-      default: forward_group<0>(d, u, w, m, columns, y, reduced_rhs_.data());
-    }
-  }
   double* x_global = x + local_dim_;
-  cholesky_->solve(reduced_rhs_.data(), x_global);
   for (const Group& g : groups_) {
-    const int d = g.dim, m = g.coupled_end - g.coupled_begin;
-    const double* u = factor_.data() + g.block;
-    const double* w = w_.data() + g.coupling;
-    const int* columns = coupled_.data() + g.coupled_begin;
-    double* y = x + g.column;
-    switch (d) {
-      case 8: backward_group<8>(d, u, w, m, columns, x_global, y); break;
-      case 6: backward_group<6>(d, u, w, m, columns, x_global, y); break;
-      default: backward_group<0>(d, u, w, m, columns, x_global, y);
-    }
+    if (x != b) std::copy(b + g.column, b + g.column + g.dim, x + g.column);
+    for_group_dim(g.dim, [&](auto size) {
+      constexpr int D = decltype(size)::value;
+      forward_group<D>(g.dim, factor_.data() + g.block, w_.data() + g.coupling, g.coupled_end - g.coupled_begin,
+                       coupled_.data() + g.coupled_begin, x + g.column, reduced_rhs_.data());
+    });
+  }
+  solve_upper_transposed<0>(s_.data(), n, reduced_rhs_.data());
+  solve_upper<0>(s_.data(), n, reduced_rhs_.data());
+  std::copy(reduced_rhs_.begin(), reduced_rhs_.end(), x_global);
+  for (const Group& g : groups_) {
+    for_group_dim(g.dim, [&](auto size) {
+      constexpr int D = decltype(size)::value;
+      backward_group<D>(g.dim, factor_.data() + g.block, w_.data() + g.coupling, g.coupled_end - g.coupled_begin,
+                        coupled_.data() + g.coupled_begin, x_global, x + g.column);
+    });
   }
 }
 

@@ -10,9 +10,12 @@
 //                                   x_l = A^-1 (b_l - B x_g),
 //
 // with A block diagonal (one dense block per pose, Cholesky in place) and S
-// over the global variables only, factorised by CHOLMOD (SparseCholesky) in
-// a pattern analysed once. An iteration costs O(poses) small dense
-// operations plus one factorisation of S, whatever the number of poses.
+// over the global variables only (at most kMaxGlobalDim of them), dense and
+// factorised in place by a dense Cholesky: every pose couples all the
+// globals it reaches, so S has (nearly) no zeros to exploit, and at 16 to
+// 128 columns a sparse factorisation costs more in overhead than in
+// arithmetic. An iteration costs O(poses) small dense operations plus one
+// factorisation of S, whatever the number of poses.
 //
 // Everything is sized in the constructor, in time linear in the number of
 // factor keys; evaluate(), accumulate(), factorize() and solve() allocate
@@ -33,9 +36,10 @@ class SchurComplement {
   // Null when the problem lacks the structure: no per-pose or no global
   // variable, a factor touching two poses' variables, a pose group larger
   // than kMaxGroupDim or more than kMaxGlobalDim global dimensions (then the
-  // whole J^T J is the better system to factorise).
+  // whole J^T J in CHOLMOD is the better system to factorise: the dense S
+  // grows as the cube of its columns).
   static constexpr int kMaxGroupDim = 16;
-  static constexpr int kMaxGlobalDim = 512;
+  static constexpr int kMaxGlobalDim = 128;
   static std::unique_ptr<SchurComplement> create(const Problem& problem);
   ~SchurComplement();
 
@@ -90,10 +94,7 @@ class SchurComplement {
   std::vector<double> c_, s_;            // global x global, column-major upper: C, then the reduced S
   std::vector<BlockOp> ops_;             // per factor, in order
   std::vector<int> op_begin_;            // per factor into ops_ (+1 at the end)
-  std::vector<int> s_starts_, s_rows_;   // pattern of S (upper, CSC)
-  std::vector<double> s_values_;
   std::vector<double> reduced_rhs_;
-  std::unique_ptr<SparseCholesky> cholesky_;
 };
 
 }  // namespace cdpr
