@@ -41,7 +41,14 @@ SolverOptions our_options() {
 }
 
 std::string to_string(CeresLinearSolver solver) {
-  return solver == CeresLinearSolver::kSparseSchur ? "ceres_schur" : "ceres_snc";
+  switch (solver) {
+    case CeresLinearSolver::kSparseNormalCholesky: return "ceres_snc";
+    case CeresLinearSolver::kSparseSchur: return "ceres_schur";
+    case CeresLinearSolver::kDenseSchur: return "ceres_dense_schur";
+    case CeresLinearSolver::kIterativeSchur: return "ceres_iter_schur";
+    case CeresLinearSolver::kDenseNormalCholesky: return "ceres_dnc";
+  }
+  return "?";
 }
 
 ceres::Solver::Options ceres_options(CeresLinearSolver solver) {
@@ -49,9 +56,18 @@ ceres::Solver::Options ceres_options(CeresLinearSolver solver) {
   ceres::Solver::Options options;
   options.minimizer_type = ceres::TRUST_REGION;
   options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  options.linear_solver_type =
-      solver == CeresLinearSolver::kSparseSchur ? ceres::SPARSE_SCHUR : ceres::SPARSE_NORMAL_CHOLESKY;
+  switch (solver) {
+    case CeresLinearSolver::kSparseNormalCholesky: options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY; break;
+    case CeresLinearSolver::kSparseSchur: options.linear_solver_type = ceres::SPARSE_SCHUR; break;
+    case CeresLinearSolver::kDenseSchur: options.linear_solver_type = ceres::DENSE_SCHUR; break;
+    case CeresLinearSolver::kIterativeSchur:
+      options.linear_solver_type = ceres::ITERATIVE_SCHUR;
+      options.preconditioner_type = ceres::SCHUR_JACOBI;
+      break;
+    case CeresLinearSolver::kDenseNormalCholesky: options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY; break;
+  }
   options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
+  options.dense_linear_algebra_library_type = ceres::EIGEN;
   options.function_tolerance = ours.function_tolerance;
   options.gradient_tolerance = ours.gradient_tolerance;
   options.parameter_tolerance = ours.parameter_tolerance;

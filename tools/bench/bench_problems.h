@@ -31,7 +31,17 @@ BuiltProblem build_problem(const BenchData& data);
 // Our solver's options for the comparison: defaults, 200 iterations like calibrate().
 SolverOptions our_options();
 
-enum class CeresLinearSolver { kSparseNormalCholesky, kSparseSchur };
+// Ceres' linear solvers worth trying on this problem (its best is what we
+// compare against): SuiteSparse Cholesky of the whole J^T J; Schur
+// elimination of the poses with the reduced system sparse (SuiteSparse) or
+// dense (Eigen); conjugate gradients on the reduced system with the
+// Schur-Jacobi preconditioner; dense Cholesky of the whole J^T J (small
+// problems only).
+enum class CeresLinearSolver { kSparseNormalCholesky, kSparseSchur, kDenseSchur, kIterativeSchur, kDenseNormalCholesky };
+inline constexpr CeresLinearSolver kCeresLinearSolvers[] = {
+    CeresLinearSolver::kSparseNormalCholesky, CeresLinearSolver::kSparseSchur, CeresLinearSolver::kDenseSchur,
+    CeresLinearSolver::kIterativeSchur, CeresLinearSolver::kDenseNormalCholesky};
+// "ceres_snc", "ceres_schur", "ceres_dense_schur", "ceres_iter_schur", "ceres_dnc".
 std::string to_string(CeresLinearSolver solver);
 
 // Ceres LM with our tolerances, initial radius and iteration cap, one thread.

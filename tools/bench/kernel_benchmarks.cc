@@ -85,7 +85,7 @@ void BM_NumericRefactorisation(benchmark::State& state) {
 
 // The refactorisation our solver does per iteration on a calibration
 // problem: the per-pose blocks damped, Cholesky-factorised and eliminated
-// (Schur complement), and CHOLMOD's numeric factorisation of the reduced
+// (Schur complement), and the dense Cholesky factorisation of the reduced
 // matrix over the 16 global columns; at the start, damping of radius 1e4.
 // Per pose count, to show it grows linearly.
 void BM_SchurRefactorisation(benchmark::State& state) {

@@ -3,7 +3,7 @@
 // the command line says otherwise, then prints a summary table.
 //
 // Peak memory mode, for a separate process per solver:
-//   cdpr-bench --peak-rss=ours|ceres_snc|ceres_schur [--poses=1000]
+//   cdpr-bench --peak-rss=ours|ceres_snc|ceres_schur|ceres_dense_schur|ceres_iter_schur|ceres_dnc [--poses=1000]
 // simulates the data set, builds the problem, solves once and prints
 // getrusage's ru_maxrss after building and after solving.
 
@@ -38,13 +38,19 @@ int peak_rss(const std::string& solver, int poses) {
   RunRecord run;
   if (solver == "ours") {
     run = solve_ours(*built.problem);
-  } else if (solver == "ceres_snc") {
-    run = solve_ceres(*built.problem, CeresLinearSolver::kSparseNormalCholesky);
-  } else if (solver == "ceres_schur") {
-    run = solve_ceres(*built.problem, CeresLinearSolver::kSparseSchur);
   } else {
-    std::fprintf(stderr, "unknown solver '%s' (ours, ceres_snc, ceres_schur)\n", solver.c_str());
-    return 2;
+    bool known = false;
+    for (CeresLinearSolver ceres : kCeresLinearSolvers) {
+      if (solver != to_string(ceres)) continue;
+      run = solve_ceres(*built.problem, ceres);
+      known = true;
+    }
+    if (!known) {
+      std::fprintf(stderr, "unknown solver '%s' (ours", solver.c_str());
+      for (CeresLinearSolver ceres : kCeresLinearSolvers) std::fprintf(stderr, ", %s", to_string(ceres).c_str());
+      std::fprintf(stderr, ")\n");
+      return 2;
+    }
   }
   const long after_solve = max_rss_kib();
   std::printf("%s poses=%d iterations=%d final_cost=%.10e peak_rss_kib: after_simulation=%ld after_build=%ld "

@@ -14,7 +14,7 @@ struct RunRecord {
   double final_cost = 0.0;
 };
 
-// series: "ours", "ceres_snc", "ceres_schur"; phase: "e2e" (build problem +
+// series: "ours" or a Ceres configuration ("ceres_snc", ...); phase: "e2e" (build problem +
 // construct solver + solve) or "solve" (construct solver + solve from the
 // same start, problem already built).
 void record(const std::string& series, const std::string& phase, int poses, const RunRecord& run);
