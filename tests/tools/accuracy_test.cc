@@ -38,6 +38,17 @@ TEST(Accuracy, NoiselessDataIsRecoveredExactlyFromTenMetrePerturbation) {
   EXPECT_LT(run.reported_sigma_m, 2.0 * run.straight_bound_m);
 }
 
+TEST(Accuracy, TheIterationLimitIsTheFitsOwn) {
+  // GIVEN a case whose fit needs several iterations, allowed only 2
+  Case c;
+  c.poses = 9;
+  c.max_iterations = 2;
+  const RunResult run = run_case(c, 3);
+  // THEN the fit stops there, far from the truth
+  EXPECT_LE(run.iterations, 2);
+  EXPECT_GT(run.anchor_error_m, 0.3);
+}
+
 TEST(Accuracy, LargeRobotWithWideWaypointsBeatsPaperAndRigidModel) {
   // GIVEN the large robot, 35 waypoints spread over the planner's wide box, noise as in the paper
   Case c;

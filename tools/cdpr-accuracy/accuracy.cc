@@ -27,6 +27,7 @@ RunResult run_case(const Case& c, std::uint64_t seed) {
   }
   CalibrationOptions options;
   options.cable_model = c.model;
+  options.max_iterations = c.max_iterations;
   const CalibrationResult result = calibrate(data->nominal, data->samples, options);
   run.ok = result.ok;
   run.message = result.message;

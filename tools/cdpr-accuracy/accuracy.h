@@ -23,6 +23,7 @@ struct Case {
   double noise_scale = 1.0;  // multiplies the preset's sensor sigmas; 0 = noiseless
   std::optional<Eigen::Vector3d> workspace_min, workspace_max;  // preset's when empty
   int design_candidates = 0;  // sim/dataset.h: 0 = even spread, N = most informative of N
+  int max_iterations = CalibrationOptions{}.max_iterations;
 };
 
 struct RunResult {

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   std::vector<double> workspace;
   int design_candidates = 0;
   double noise_scale = 1.0;
+  int max_iterations = cdpr::CalibrationOptions{}.max_iterations;
   bool model_check_only = false, verbose = false;
   app.add_option("--preset", preset_name, "large | small")->check(CLI::IsMember({"large", "small"}))->capture_default_str();
   app.add_option("--poses", poses, "static poses per data set")->capture_default_str();
@@ -42,6 +43,8 @@ int main(int argc, char** argv) {
                  "multiplies the preset's sensor noise; 0 = noiseless data fitted with the preset's sigmas, so the "
                  "reported sigmas are the model's Cramer-Rao bound for these poses")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--max-iterations", max_iterations, "Levenberg-Marquardt iterations per fit, at most")
+      ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_flag("--model-check", model_check_only, "only run the Table I model check");
   app.add_flag("-v,--verbose", verbose, "one line per run");
   CLI11_PARSE(app, argc, argv);
@@ -71,6 +74,7 @@ int main(int argc, char** argv) {
   }
   c.design_candidates = design_candidates;
   c.noise_scale = noise_scale;
+  c.max_iterations = max_iterations;
   std::vector<cdpr::CableModelKind> models;
   if (model != "rigid") models.push_back(cdpr::CableModelKind::kCatenary);
   if (model != "catenary") models.push_back(cdpr::CableModelKind::kRigid);
