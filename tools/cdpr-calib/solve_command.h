@@ -5,6 +5,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "solver/calibrate.h"
+
 namespace cdpr::tools {
 
 struct SolveArgs {
@@ -15,7 +17,7 @@ struct SolveArgs {
   std::string model = "catenary";
   double huber_width = 0.0;
   double height_sigma_m = 1e-2;
-  int max_iterations = 200;
+  int max_iterations = CalibrationOptions{}.max_iterations;
   bool quiet = false;
 };
 
