@@ -32,6 +32,29 @@ std::size_t past_closing(std::string_view text, std::size_t at, char quote) {
   return end;
 }
 
+// What toml++ ends a bare value at (is_value_terminator, ASCII part).
+bool ends_bare_value(char c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == ',' || c == ']' || c == '}' || c == '#';
+}
+
+bool is_digit(char c) { return c >= '0' && c <= '9'; }
+
+// The end of the bare value (number, boolean, date-time, inf/nan) that
+// starts at `at`: toml++ scans it up to a terminator with its whitespace test
+// on every character, quotes included (they open no string inside a value),
+// and a date followed by one space and a digit continues as date-time.
+std::size_t bare_value_end(std::string_view text, std::size_t at) {
+  std::size_t end = at;
+  for (;;) {
+    while (end < text.size() && !ends_bare_value(text[end])) ++end;
+    if (end + 1 < text.size() && text[end] == ' ' && is_digit(text[end + 1])) {
+      ++end;
+      continue;
+    }
+    return end;
+  }
+}
+
 }  // namespace
 
 std::optional<FormatError> find_unsafe_non_ascii(std::string_view text, const std::string& source) {
@@ -42,12 +65,39 @@ std::optional<FormatError> find_unsafe_non_ascii(std::string_view text, const st
                        "non-ASCII character outside a string or comment (or first on the line after a "
                        "line-ending backslash in a \"\"\" string)"};
   };
+  // Where a value starts (after '=', '[' of an array value, ',' in an
+  // array) toml++ reads a bare value through its whitespace test, quotes
+  // and all; elsewhere a quote opens a string. Open arrays ('[') and inline
+  // tables ('{') of values, innermost last, tell what a ',' is followed by.
+  bool value_expected = false;
+  std::string open_brackets;
   std::size_t i = 0;
   while (i < text.size()) {
     const char c = text[i];
     switch (context) {
       case Context::kCode:
         if (non_ascii(c)) return refuse(line);
+        if (value_expected && !ends_bare_value(c) && c != '"' && c != '\'' && c != '[' && c != '{') {
+          const std::size_t end = bare_value_end(text, i);
+          for (; i < end; ++i) {
+            if (non_ascii(text[i])) return refuse(line);
+          }
+          value_expected = false;
+          continue;
+        }
+        if (c == '=') {
+          value_expected = true;
+        } else if ((c == '[' || c == '{') && (value_expected || !open_brackets.empty())) {
+          open_brackets.push_back(c);
+          value_expected = c == '[';
+        } else if (c == ',' && !open_brackets.empty()) {
+          value_expected = open_brackets.back() == '[';
+        } else if ((c == ']' || c == '}') && !open_brackets.empty()) {
+          open_brackets.pop_back();
+          value_expected = false;
+        } else if (c != ' ' && c != '\t' && c != '\r' && c != '\n' && c != '#') {
+          value_expected = false;  // a string or key starts: no bare value here
+        }
         if (c == '#') {
           context = Context::kComment;
         } else if (starts_with_at(text, i, "\"\"\"")) {

@@ -7,6 +7,10 @@
 // the daemon (upstream marzer/tomlplusplus#295 and #190; found by
 // fuzz_calibration_toml). Outside strings and comments TOML 1.0 allows only
 // ASCII anyway, so no valid file is refused but for the rare second case.
+// toml++ reads a bare value (number, boolean, date-time) up to the next
+// whitespace, ',', ']', '}' or '#' through that test, quotes included, so a
+// quote inside such a value opens no string here either (found by
+// fuzz_robot_toml: `[0.0"""` followed by U+025F).
 
 #include <optional>
 #include <string>
@@ -18,7 +22,8 @@ namespace cdpr::formats {
 
 // The first non-ASCII byte at a place listed above, as an error naming its
 // line; nullopt when there is none. Tracks comments, basic, literal and
-// multi-line strings; never reads past `text`.
+// multi-line strings, and where values start (after '=', in arrays); never
+// reads past `text`.
 std::optional<FormatError> find_unsafe_non_ascii(std::string_view text, const std::string& source);
 
 }  // namespace cdpr::formats

@@ -26,7 +26,11 @@ TEST(TomlTextCheck, RefusesNonAsciiOutsideStringsAndCommentsWithItsLine) {
   };
   for (const Case& bad : {Case{"\xcc\xaa", 1}, Case{"a = 1\nb = [0.0, 50.\xcd\xa2]\n", 2},
                           Case{"# ok\n\n k\xc3\xbc = 1\n", 3}, Case{"s = \"\"\"\\\n\xc2\xa7\"\"\"\n", 2},
-                          Case{"s = \"\"\"\\  \r\n\n   \xc2\xa7\"\"\"\n", 3}}) {
+                          Case{"s = \"\"\"\\  \r\n\n   \xc2\xa7\"\"\"\n", 3},
+                          // a quote inside a bare value opens no string for toml++ (fuzz_robot_toml, U+025F)
+                          Case{"x = [0.0\"\"\"c\xc9\x9f\"\"\"]\n", 1},
+                          Case{"d = 1979-05-27 07:32:00\"\xc9\x9f\"\n", 1},
+                          Case{"a = [\n 1,\n # c\n 2\"\xc9\x9f\"]\n", 4}, Case{"t = {a = 1, b = 2'\xc9\x9f'}\n", 1}}) {
     // WHEN checked THEN refused at its line
     const auto error = find_unsafe_non_ascii(bad.text, "f.toml");
     ASSERT_TRUE(error.has_value()) << bad.text;
@@ -41,13 +45,17 @@ TEST(TomlTextCheck, AcceptsNonAsciiInStringsAndComments) {
   for (const std::string good :
        {"name = \"Gro\xc3\x9f \\\"\xc3\xbc\\\" Roboter\" # K\xc3\xb6ln\n", "n = 'caf\xc3\xa9'\n",
         "s = \"\"\"\n\xc2\xa7 line \\\" two \xc2\xa7\"\"\"\"\"\nt = 1 # \xc2\xa7\n", "s = '''\xc2\xa7'''''\n",
-        "s = \"\"\"x\\n\xc2\xa7\"\"\"\n"}) {
+        "s = \"\"\"x\\n\xc2\xa7\"\"\"\n",
+        // strings where values and keys start: in arrays, inline tables, dotted keys, table headers
+        "a.\"\xc9\x9f\" = 1\n", "x = [\"\xc9\x9f\", '\xc9\x9f', \"\"\"\xc9\x9f\"\"\"]\n",
+        "t = {a = \"\xc9\x9f\", \"\xc9\x9f\" = 1}\n", "[a.\"\xc9\x9f\"]\nk = 1\n",
+        "x = [\n 1, # \xc9\x9f\n \"\xc9\x9f\",\n]\n"}) {
     // WHEN checked THEN nothing is refused
     EXPECT_FALSE(find_unsafe_non_ascii(good, "f.toml").has_value()) << good;
   }
 }
 
-TEST(TomlTextCheck, ParsersRefuseTheFuzzersInputAndKeepNonAsciiNames) {
+TEST(TomlTextCheck, ParsersRefuseTheFuzzersInputsAndKeepNonAsciiNames) {
   // GIVEN the input that made fuzz_calibration_toml reach toml++'s unreachable code
   const auto crashing = read_text_file(std::string(CDPR_SOURCE_DIR) +
                                        "/tests/fuzz/corpus/calibration_toml/non_ascii_after_number_crash.toml");
@@ -57,6 +65,13 @@ TEST(TomlTextCheck, ParsersRefuseTheFuzzersInputAndKeepNonAsciiNames) {
   ASSERT_FALSE(calibration.has_value());
   EXPECT_NE(calibration.error().reason.find("non-ASCII"), std::string::npos) << calibration.error().message();
   EXPECT_GT(calibration.error().line, 0);
+  // AND so is fuzz_robot_toml's: a multi-line string opener inside a number
+  const auto quoted = read_text_file(std::string(CDPR_SOURCE_DIR) +
+                                     "/tests/fuzz/corpus/robot_toml/quote_inside_number_crash.toml");
+  ASSERT_TRUE(quoted.has_value());
+  const auto refused = parse_robot_toml(*quoted, "crash.toml");
+  ASSERT_FALSE(refused.has_value());
+  EXPECT_NE(refused.error().reason.find("non-ASCII"), std::string::npos) << refused.error().message();
   // AND a robot named with non-ASCII letters still round-trips
   Robot robot;
   robot.name = "Gro\xc3\x9f\xc3\xa9r Roboter";
