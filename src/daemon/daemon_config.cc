@@ -80,6 +80,20 @@ class ConfigReader {
   TomlReader& reader_;
 };
 
+// What getgrnam() can be asked for and chown() given: a portable group name
+// (useradd's rules, Samba's trailing '$' included) or a decimal id.
+bool is_group_name_or_id(const std::string& group) {
+  if (group.size() > 32 || group.front() == '-') return false;
+  const std::size_t last = group.back() == '$' ? group.size() - 1 : group.size();
+  for (std::size_t i = 0; i < last; ++i) {
+    const char c = group[i];
+    const bool allowed = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' ||
+                         c == '_' || c == '-';
+    if (!allowed) return false;
+  }
+  return last > 0;
+}
+
 void read_winches(TomlReader& reader, ConfigReader& r, const toml::table& root, WinchesConfig& out) {
   const toml::table& t = reader.table(root, "winches", "", kOptional);
   reader.check_keys(t, "winches", {{"endpoint", kOptional}, {"heartbeat_timeout_ms", kOptional},
@@ -140,8 +154,14 @@ void read_io(TomlReader& reader, ConfigReader& r, const toml::table& root, Daemo
   r.integer(store, "history_depth", "store", c.store.history_depth, 0, 1000);
 
   const toml::table& control = reader.table(root, "control", "", kOptional);
-  reader.check_keys(control, "control", {{"socket", kOptional}});
+  reader.check_keys(control, "control", {{"socket", kOptional}, {"group", kOptional}});
   r.string(control, "socket", "control", c.control_socket);
+  r.string(control, "group", "control", c.control_socket_group);
+  if (!c.control_socket_group.empty() && !is_group_name_or_id(c.control_socket_group)) {
+    r.fail(control, "group", "control",
+           "\"" + c.control_socket_group + "\" is not a group name (letters, digits, '.', '_', '-'; at most 32) "
+           "or a numeric group id");
+  }
 
   const toml::table& loop = reader.table(root, "loop", "", kOptional);
   reader.check_keys(loop, "loop", {{"period_ms", kOptional}});

@@ -69,6 +69,9 @@ struct DaemonConfig {
   std::string robot_path;  // robot.toml
   store::StoreOptions store{"/var/lib/cdpr-calib", 10};
   std::string control_socket = "/run/cdpr-calib/control";
+  // Group given the control socket (mode 0660): its members may control the
+  // daemon. A group name or a numeric id; empty: the daemon's own group.
+  std::string control_socket_group;
   hal::TimeUs loop_period_us = 20'000;
   WinchesConfig winches;
   LoadCellConfig load_cell;

@@ -36,8 +36,9 @@ DaemonLoop::DaemonLoop(const DaemonConfig& config, const Robot& robot, DaemonDev
 DaemonLoop::~DaemonLoop() { shutdown(); }
 
 hal::Status DaemonLoop::start() {
-  auto server = ControlServer::listen(config_.control_socket,
-                                      [this](std::string_view line) { return handle_request(line); });
+  auto server = ControlServer::listen(
+      config_.control_socket, [this](std::string_view line) { return handle_request(line); }, kControlSocketMode,
+      config_.control_socket_group);
   if (!server.ok()) return server.status();
   server_ = std::move(server.value());
   const hal::TimeUs now_us = clock_.now_us();

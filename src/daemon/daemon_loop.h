@@ -61,6 +61,8 @@ struct DaemonDevices {
 class DaemonLoop {
  public:
   static constexpr hal::TimeUs kReconnectIntervalUs = 2'000'000;
+  // Owner and group ([control] group) may connect; nobody else.
+  static constexpr unsigned kControlSocketMode = 0660;
 
   // `log` receives one line per event (state changes, device errors); may be empty.
   DaemonLoop(const DaemonConfig& config, const Robot& robot, DaemonDevices devices, store::CalibrationStore& store,

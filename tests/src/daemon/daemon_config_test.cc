@@ -23,6 +23,7 @@ TEST(DaemonConfig, TheShippedExampleParsesToTheDefaults) {
   EXPECT_EQ(config->store.state_dir, defaults.store.state_dir);
   EXPECT_EQ(config->store.history_depth, defaults.store.history_depth);
   EXPECT_EQ(config->control_socket, defaults.control_socket);
+  EXPECT_EQ(config->control_socket_group, "");  // the daemon's own group
   EXPECT_EQ(config->loop_period_us, defaults.loop_period_us);
   ASSERT_EQ(config->winches.winches.size(), 4u);
   for (int i = 0; i < 4; ++i) {
@@ -52,6 +53,8 @@ TEST(DaemonConfig, TheShippedExampleParsesToTheDefaults) {
 TEST(DaemonConfig, ReadsTheValuesGivenWithTheirUnits) {
   // GIVEN a configuration for the virtual robot
   const std::string text = R"(robot = "/tmp/robot.toml"
+[control]
+group = "robot-operators"
 [loop]
 period_ms = 10
 [winches]
@@ -73,6 +76,7 @@ accept_max_iterations = true
   const auto config = parse_daemon_config(text, "vr.toml");
   // THEN the values are there in the daemon's units
   ASSERT_TRUE(config) << config.error().message();
+  EXPECT_EQ(config->control_socket_group, "robot-operators");
   EXPECT_EQ(config->loop_period_us, 10'000);
   EXPECT_EQ(config->winches.endpoint, "unix:/tmp/can.sock");
   EXPECT_EQ(config->load_cell.parity, 'E');
@@ -97,6 +101,10 @@ TEST(DaemonConfig, RefusesBadInputNamingLineAndKey) {
       {"robot = \"r\"\n[button]\nactive_low = 1\n", 3, "button.active_low"},               // not a bool
       {"[store]\nstate_dir = \"/x\"\n", 0, "robot"},                                        // missing required
       {"robot = \"r\"\n[[winches.winch]]\ndrive_node_id = 1\n", 2, "winches.winch"},       // not 4 winches
+      {"robot = \"r\"\n[control]\ngroup = \"robot operators\"\n", 3, "control.group"},   // not a group name
+      {"robot = \"r\"\n[control]\ngroup = \"-x\"\n", 3, "control.group"},                // option-like name
+      {"robot = \"r\"\n[control]\ngroup = 1000\n", 3, "control.group"},                    // not a string
+      {"robot = \"r\"\n[control]\ngroup = \"\"\n", 3, "control.group"},                  // empty
   };
   for (const Case& c : cases) {
     // GIVEN a configuration with one mistake WHEN parsed
@@ -109,6 +117,21 @@ TEST(DaemonConfig, RefusesBadInputNamingLineAndKey) {
     }
     EXPECT_EQ(config.error().file, "bad.toml");
   }
+}
+
+TEST(DaemonConfig, TheControlSocketGroupIsANameOrANumericId) {
+  for (const std::string group : {"cdpr-operators", "robot_ops", "Ops.1", "machine$", "1001", "0"}) {
+    // GIVEN [control] group set to a group name or id WHEN parsed
+    const auto config = parse_daemon_config("robot = \"r\"\n[control]\ngroup = \"" + group + "\"\n", "g.toml");
+    // THEN it is taken as it is (whether it exists is checked when the socket is made)
+    ASSERT_TRUE(config) << config.error().message();
+    EXPECT_EQ(config->control_socket_group, group);
+  }
+  // AND a refusal says what a group must look like
+  const auto refused = parse_daemon_config("robot = \"r\"\n[control]\ngroup = \"a:b\"\n", "g.toml");
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message().find("g.toml:3"), std::string::npos) << refused.error().message();
+  EXPECT_NE(refused.error().message().find("group name"), std::string::npos) << refused.error().message();
 }
 
 }  // namespace
