@@ -16,19 +16,11 @@
 #include <gtest/gtest.h>
 
 #include "../fakes/manual_clock.h"
+#include "../fakes/modbus_crc.h"
 #include "drivers/modbus/modbus_load_cell.h"
 
 namespace cdpr::drivers::modbus {
 namespace {
-
-std::uint16_t modbus_crc(const std::uint8_t* data, std::size_t length) {
-  std::uint16_t crc = 0xFFFF;
-  for (std::size_t i = 0; i < length; ++i) {
-    crc ^= data[i];
-    for (int bit = 0; bit < 8; ++bit) crc = (crc & 1) ? static_cast<std::uint16_t>((crc >> 1) ^ 0xA001) : crc >> 1;
-  }
-  return crc;
-}
 
 class FakeRtuCell {
  public:
@@ -70,7 +62,7 @@ class FakeRtuCell {
   void reply(std::uint8_t slave, std::uint8_t function) {
     // 1234.5 N as float32 0x449A5000, high word first; status: stable.
     std::vector<std::uint8_t> frame = {slave, function, 6, 0x44, 0x9A, 0x50, 0x00, 0x00, 0x01};
-    const std::uint16_t crc = modbus_crc(frame.data(), frame.size());
+    const std::uint16_t crc = fakes::modbus_crc16(frame.data(), frame.size());
     frame.push_back(static_cast<std::uint8_t>(crc & 0xFF));
     frame.push_back(static_cast<std::uint8_t>(crc >> 8));
     if (mode_ == Mode::kBadCrc) frame.back() ^= 0x5A;

@@ -14,7 +14,7 @@ seconds="$2"
 shift 2
 targets=("$@")
 if [[ ${#targets[@]} -eq 0 ]]; then
-  targets=(robot_toml samples_csv calibration_toml control_request can_frames modbus_reply pose_stream)
+  targets=(robot_toml samples_csv calibration_toml control_request can_frames modbus_reply modbus_frames pose_stream)
 fi
 mkdir -p "$build/fuzz-corpus" "$build/fuzz-artifacts" "$build/fuzz-logs"
 summary=()
