@@ -37,7 +37,7 @@ ModbusServer::ModbusServer(modbus_t* context, modbus_mapping_t* mapping, int lis
     : context_(context), mapping_(mapping), listen_fd_(listen_fd), port_(port), order_(order) {}
 
 ModbusServer::~ModbusServer() {
-  for (const int fd : clients_) close(fd);
+  for (const Client& client : clients_) close(client.fd);
   close(listen_fd_);
   modbus_mapping_free(mapping_);
   modbus_free(context_);  // its socket is one of the clients, already closed
@@ -52,7 +52,28 @@ void ModbusServer::set_value(const drivers::modbus::TensionRegisters& value) {
 
 void ModbusServer::append_poll_fds(std::vector<pollfd>& fds) const {
   fds.push_back({listen_fd_, POLLIN, 0});
-  for (const int fd : clients_) fds.push_back({fd, POLLIN, 0});
+  for (const Client& client : clients_) fds.push_back({client.fd, POLLIN, 0});
+}
+
+bool ModbusServer::answer_whole_requests(Client& client) {
+  // MBAP header: transaction id (2), protocol id (2), length (2) of what
+  // follows it: unit id, function, data.
+  constexpr std::size_t kLengthFieldEnd = 6;
+  std::size_t used = 0;
+  while (client.pending.size() - used >= kLengthFieldEnd) {
+    const auto* header = reinterpret_cast<const std::uint8_t*>(client.pending.data() + used);
+    const std::size_t frame = kLengthFieldEnd + ((header[4] << 8) | header[5]);
+    if (frame < kLengthFieldEnd + 2 || frame > MODBUS_TCP_MAX_ADU_LENGTH) return false;
+    if (client.pending.size() - used < frame) break;
+    if (!mute_) {
+      ++requests_;
+      modbus_set_socket(context_, client.fd);
+      if (modbus_reply(context_, header, static_cast<int>(frame), mapping_) < 0) return false;
+    }
+    used += frame;
+  }
+  client.pending.erase(0, used);
+  return true;
 }
 
 void ModbusServer::service(const std::vector<pollfd>& fds) {
@@ -60,25 +81,23 @@ void ModbusServer::service(const std::vector<pollfd>& fds) {
   for (const pollfd& entry : fds) {
     if (entry.revents == 0) continue;
     if (entry.fd == listen_fd_) {
-      for (int fd; (fd = accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC)) >= 0;) clients_.push_back(fd);
+      for (int fd; (fd = accept4(listen_fd_, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC)) >= 0;) {
+        clients_.push_back({fd, {}});
+      }
       continue;
     }
-    if (std::find(clients_.begin(), clients_.end(), entry.fd) == clients_.end()) continue;
-    // The request has arrived (readable): modbus_receive reads it whole.
-    std::uint8_t query[MODBUS_TCP_MAX_ADU_LENGTH];
-    modbus_set_socket(context_, entry.fd);
-    const int length = modbus_receive(context_, query);
-    if (length < 0) {
-      closed.push_back(entry.fd);
-      continue;
-    }
-    if (length == 0 || mute_) continue;  // not for us, or muted
-    ++requests_;
-    if (modbus_reply(context_, query, length, mapping_) < 0) closed.push_back(entry.fd);
+    const auto client = std::find_if(clients_.begin(), clients_.end(),
+                                     [&](const Client& c) { return c.fd == entry.fd; });
+    if (client == clients_.end()) continue;
+    char buffer[MODBUS_TCP_MAX_ADU_LENGTH];
+    const ssize_t got = recv(client->fd, buffer, sizeof(buffer), 0);
+    if (got < 0 && (errno == EAGAIN || errno == EINTR)) continue;
+    if (got > 0) client->pending.append(buffer, static_cast<std::size_t>(got));
+    if (got <= 0 || !answer_whole_requests(*client)) closed.push_back(client->fd);
   }
   for (const int fd : closed) {
     close(fd);
-    std::erase(clients_, fd);
+    std::erase_if(clients_, [fd](const Client& c) { return c.fd == fd; });
   }
 }
 

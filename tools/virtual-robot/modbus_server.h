@@ -2,9 +2,17 @@
 // The virtual robot's load cell: a real Modbus TCP server (libmodbus) on
 // 127.0.0.1 serving the register map of drivers/modbus/tension_registers.h
 // at address 0, as both holding and input registers (function 0x03 and
-// 0x04), for any number of clients. Non-blocking accept; one request is
-// answered per readable client per service() call.
-// Owns its libmodbus context and sockets. Not thread-safe.
+// 0x04), for any number of clients.
+//
+// It runs on the virtual robot's physics thread, so nothing here may wait
+// for a client: sockets are non-blocking, each client's bytes are gathered
+// until a whole request (MBAP header + its length) is there and only then
+// handed to libmodbus to answer (libmodbus' own receive would wait up to its
+// byte timeout per byte for a client that sends slowly), and a client that
+// does not read its replies is dropped when one no longer fits its socket
+// buffer (libmodbus' send would block). A header announcing an impossible
+// length drops the client too. Owns its libmodbus context and sockets.
+// Not thread-safe.
 
 #include <poll.h>
 
@@ -36,9 +44,11 @@ class ModbusServer {
   void set_mute(bool mute) { mute_ = mute; }
 
   void append_poll_fds(std::vector<pollfd>& fds) const;
+  // Accepts, reads what is ready and answers every whole request. Never blocks.
   void service(const std::vector<pollfd>& fds);
 
   unsigned long long requests() const { return requests_; }
+  std::size_t client_count() const { return clients_.size(); }
 
  private:
   ModbusServer(modbus_t* context, modbus_mapping_t* mapping, int listen_fd, int port,
@@ -49,7 +59,15 @@ class ModbusServer {
   int listen_fd_;
   int port_;
   drivers::modbus::WordOrder order_;
-  std::vector<int> clients_;
+  // Answers the whole requests at the front of `client.pending`; false when
+  // the client must go (garbage header, reply did not fit).
+  struct Client {
+    int fd;
+    std::string pending;  // bytes of requests not yet whole
+  };
+  bool answer_whole_requests(Client& client);
+
+  std::vector<Client> clients_;
   bool mute_ = false;
   unsigned long long requests_ = 0;
 };
