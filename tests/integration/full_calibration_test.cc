@@ -15,12 +15,7 @@ namespace {
 
 TEST(FullCalibration, LargeRobotWith35WaypointsFindsTheAnchorsWithin10cm) {
   // GIVEN the virtual large robot (physics 20x faster than real time, nominal anchors 0.3 m off) and the daemon
-  virtual_robot::VirtualRobotOptions options;
-  options.preset = sim::Preset::kLarge;
-  options.seed = 1;
-  options.time_scale = 20.0;
-  options.anchor_perturbation_m = 0.3;
-  VirtualRobotRig rig(options);
+  VirtualRobotRig rig(large_robot_acceptance_options());
   ASSERT_EQ(rig.config.calibrator.planner.waypoint_count, 35);
 
   // WHEN the operator starts a calibration (once the nodes' heartbeats are in) and it runs to its end

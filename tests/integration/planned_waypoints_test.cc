@@ -8,26 +8,21 @@
 
 #include "sim/dataset.h"
 #include "sim/equilibrium.h"
-#include "sim/presets.h"
 #include "src/calibration/waypoint_planner.h"
 #include "src/daemon/daemon_config.h"
 #include "virtual-robot/robot_physics.h"
+#include "virtual_robot_rig.h"
 
 namespace cdpr::integration {
 namespace {
 
 TEST(PlannedWaypoints, TheTrueLargeRobotRestsNearEveryWaypointPlannedFromNominalAnchors) {
-  // GIVEN the large robot, nominal anchors 0.3 m off, at rest in the middle of the workspace
-  sim::DatasetConfig config;
-  config.preset = sim::Preset::kLarge;
-  config.seed = 1;
-  config.pose_count = 1;
-  config.anchor_perturbation_m = 0.3;
-  const auto data = sim::simulate_dataset(config);
+  // GIVEN the virtual robot of the full calibration test (large, nominal anchors 0.3 m off), at rest where it starts
+  const virtual_robot::VirtualRobotOptions robot_options = large_robot_acceptance_options();
+  const auto data = sim::simulate_dataset(virtual_robot::dataset_config(robot_options));
   ASSERT_TRUE(data) << data.error();
   const sim::TrueRobot& truth = data->true_robot;
-  const sim::PresetSpec spec = sim::preset_spec(sim::Preset::kLarge);
-  const Eigen::Vector3d start_world = 0.5 * (spec.workspace_min + spec.workspace_max);
+  const Eigen::Vector3d start_world = virtual_robot::start_position_world(robot_options.preset);
   const auto start = sim::solve_equilibrium(truth, start_world, 0.0);
   ASSERT_TRUE(start) << start.error().message;
   std::array<double, kCableCount> encoder_m{};

@@ -27,8 +27,7 @@ bool write_file(const std::string& path, const std::string& text) {
 
 }  // namespace
 
-Expected<std::unique_ptr<VirtualRobot>, std::string> VirtualRobot::create(const VirtualRobotOptions& options) {
-  if (!(options.time_scale > 0.0)) return Unexpected{std::string("time scale must be > 0")};
+sim::DatasetConfig dataset_config(const VirtualRobotOptions& options) {
   // The simulator's own data-set builder gives the true robot (random true
   // offsets) and the nominal robot.toml exactly as cdpr-sim would.
   sim::DatasetConfig config;
@@ -38,13 +37,22 @@ Expected<std::unique_ptr<VirtualRobot>, std::string> VirtualRobot::create(const 
   config.anchor_perturbation_m = options.anchor_perturbation_m;
   config.noise_scale = options.noise_scale;
   config.segments = options.physics.segments;
-  auto data = sim::simulate_dataset(config);
+  return config;
+}
+
+Eigen::Vector3d start_position_world(sim::Preset preset) {
+  const sim::PresetSpec spec = sim::preset_spec(preset);
+  return 0.5 * (spec.workspace_min + spec.workspace_max);
+}
+
+Expected<std::unique_ptr<VirtualRobot>, std::string> VirtualRobot::create(const VirtualRobotOptions& options) {
+  if (!(options.time_scale > 0.0)) return Unexpected{std::string("time scale must be > 0")};
+  auto data = sim::simulate_dataset(dataset_config(options));
   if (!data) return Unexpected{"simulated robot: " + data.error()};
   auto robot = std::unique_ptr<VirtualRobot>(new VirtualRobot(options, std::move(*data)));
 
-  const sim::PresetSpec spec = sim::preset_spec(options.preset);
-  const Eigen::Vector3d start_world = 0.5 * (spec.workspace_min + spec.workspace_max);
-  auto physics = RobotPhysics::at_rest(robot->data_.true_robot, start_world, options.physics);
+  auto physics =
+      RobotPhysics::at_rest(robot->data_.true_robot, start_position_world(options.preset), options.physics);
   if (!physics) return Unexpected{physics.error()};
   robot->physics_ = std::make_unique<RobotPhysics>(std::move(*physics));
 

@@ -53,6 +53,14 @@ struct VirtualRobotOptions {
   NodeLayout nodes;                   // encoder noise is set from the preset
 };
 
+// The simulated data set behind a virtual robot made with `options` (the
+// simulator's builder, as cdpr-sim, one pose): its true robot (true anchors
+// and encoder offsets) and the nominal robot of robot.toml.
+sim::DatasetConfig dataset_config(const VirtualRobotOptions& options);
+// Where the platform rests when a virtual robot of `preset` starts: the
+// middle of the preset's workspace [m, world].
+Eigen::Vector3d start_position_world(sim::Preset preset);
+
 class VirtualRobot {
  public:
   static Expected<std::unique_ptr<VirtualRobot>, std::string> create(const VirtualRobotOptions& options);
