@@ -24,6 +24,20 @@ std::size_t after_line_ending_backslash(std::string_view text, std::size_t backs
   return i;
 }
 
+// Whether the escape at `backslash` (in a basic or """ string) puts a
+// non-ASCII byte where toml++ tests for whitespace: right after the
+// backslash, or first after blanks and newlines that follow it (toml++ reads
+// those as a line-ending backslash's whitespace). No valid escape has
+// non-ASCII text there. `lines` counts the newlines passed.
+bool unsafe_escape(std::string_view text, std::size_t backslash, int& lines) {
+  std::size_t i = backslash + 1;
+  while (i < text.size() && (text[i] == ' ' || text[i] == '\t' || text[i] == '\r' || text[i] == '\n')) {
+    lines += text[i] == '\n';
+    ++i;
+  }
+  return i < text.size() && non_ascii(text[i]);
+}
+
 // Past a closing delimiter of a multi-line string: up to two more quotes
 // belong to the content (TOML 1.0: """"" ends with two quotes of text).
 std::size_t past_closing(std::string_view text, std::size_t at, char quote) {
@@ -62,8 +76,8 @@ std::optional<FormatError> find_unsafe_non_ascii(std::string_view text, const st
   int line = 1;
   const auto refuse = [&](int at_line) {
     return FormatError{source, at_line, "",
-                       "non-ASCII character outside a string or comment (or first on the line after a "
-                       "line-ending backslash in a \"\"\" string)"};
+                       "non-ASCII character outside a string or comment, inside a number, date or "
+                       "boolean, or after a backslash in a string (toml++ 3.3.0 mishandles it there)"};
   };
   // Where a value starts (after '=', '[' of an array value, ',' in an
   // array) toml++ reads a bare value through its whitespace test, quotes
@@ -118,6 +132,7 @@ std::optional<FormatError> find_unsafe_non_ascii(std::string_view text, const st
         if (c == '\n') context = Context::kCode;
         break;
       case Context::kBasic:
+        if (int lines = line; c == '\\' && unsafe_escape(text, i, lines)) return refuse(lines);
         if (c == '\\' && i + 1 < text.size() && text[i + 1] != '\n') {
           ++i;  // an escaped character, e.g. \"
         } else if (c == '"' || c == '\n') {
@@ -128,6 +143,7 @@ std::optional<FormatError> find_unsafe_non_ascii(std::string_view text, const st
         if (c == '\'' || c == '\n') context = Context::kCode;
         break;
       case Context::kMultiBasic:
+        if (int lines = line; c == '\\' && unsafe_escape(text, i, lines)) return refuse(lines);
         if (c == '\\') {
           const std::size_t next = after_line_ending_backslash(text, i);
           if (next == std::string_view::npos) {

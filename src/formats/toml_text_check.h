@@ -10,7 +10,9 @@
 // toml++ reads a bare value (number, boolean, date-time) up to the next
 // whitespace, ',', ']', '}' or '#' through that test, quotes included, so a
 // quote inside such a value opens no string here either (found by
-// fuzz_robot_toml: `[0.0"""` followed by U+025F).
+// fuzz_robot_toml: `[0.0"""` followed by U+025F). After a backslash in a
+// string toml++ tests the next character, and any blanks and newlines after
+// it, for whitespace too (found by both TOML fuzzers: U+FEF7, U+FE7F).
 
 #include <optional>
 #include <string>

@@ -30,7 +30,10 @@ TEST(TomlTextCheck, RefusesNonAsciiOutsideStringsAndCommentsWithItsLine) {
                           // a quote inside a bare value opens no string for toml++ (fuzz_robot_toml, U+025F)
                           Case{"x = [0.0\"\"\"c\xc9\x9f\"\"\"]\n", 1},
                           Case{"d = 1979-05-27 07:32:00\"\xc9\x9f\"\n", 1},
-                          Case{"a = [\n 1,\n # c\n 2\"\xc9\x9f\"]\n", 4}, Case{"t = {a = 1, b = 2'\xc9\x9f'}\n", 1}}) {
+                          Case{"a = [\n 1,\n # c\n 2\"\xc9\x9f\"]\n", 4}, Case{"t = {a = 1, b = 2'\xc9\x9f'}\n", 1},
+                          // right after a backslash, or after blanks following it, in a string (U+FEF7, U+FE7F)
+                          Case{"s = \"\"\"-\n = nchT\\\xef\xbb\xb7 }\"\"\"\n", 2}, Case{"s = \"a\\\xc9\x9f\"\n", 1},
+                          Case{"s = \"a\\ \xef\xb9\xbf\"\n", 1}}) {
     // WHEN checked THEN refused at its line
     const auto error = find_unsafe_non_ascii(bad.text, "f.toml");
     ASSERT_TRUE(error.has_value()) << bad.text;
@@ -49,7 +52,9 @@ TEST(TomlTextCheck, AcceptsNonAsciiInStringsAndComments) {
         // strings where values and keys start: in arrays, inline tables, dotted keys, table headers
         "a.\"\xc9\x9f\" = 1\n", "x = [\"\xc9\x9f\", '\xc9\x9f', \"\"\"\xc9\x9f\"\"\"]\n",
         "t = {a = \"\xc9\x9f\", \"\xc9\x9f\" = 1}\n", "[a.\"\xc9\x9f\"]\nk = 1\n",
-        "x = [\n 1, # \xc9\x9f\n \"\xc9\x9f\",\n]\n"}) {
+        "x = [\n 1, # \xc9\x9f\n \"\xc9\x9f\",\n]\n",
+        // after an escaped backslash
+        "s = \"a\\\\\xc9\x9f\"\n", "s = \"\"\"a\\\\\xc9\x9f\"\"\"\n"}) {
     // WHEN checked THEN nothing is refused
     EXPECT_FALSE(find_unsafe_non_ascii(good, "f.toml").has_value()) << good;
   }
@@ -65,13 +70,16 @@ TEST(TomlTextCheck, ParsersRefuseTheFuzzersInputsAndKeepNonAsciiNames) {
   ASSERT_FALSE(calibration.has_value());
   EXPECT_NE(calibration.error().reason.find("non-ASCII"), std::string::npos) << calibration.error().message();
   EXPECT_GT(calibration.error().line, 0);
-  // AND so is fuzz_robot_toml's: a multi-line string opener inside a number
-  const auto quoted = read_text_file(std::string(CDPR_SOURCE_DIR) +
-                                     "/tests/fuzz/corpus/robot_toml/quote_inside_number_crash.toml");
-  ASSERT_TRUE(quoted.has_value());
-  const auto refused = parse_robot_toml(*quoted, "crash.toml");
-  ASSERT_FALSE(refused.has_value());
-  EXPECT_NE(refused.error().reason.find("non-ASCII"), std::string::npos) << refused.error().message();
+  // AND so are the later finds: a multi-line string opener inside a number,
+  // non-ASCII text after a backslash in a string
+  for (const char* later : {"robot_toml/quote_inside_number_crash.toml", "robot_toml/non_ascii_after_backslash_crash.toml",
+                            "calibration_toml/non_ascii_after_backslash_crash.toml"}) {
+    const auto input = read_text_file(std::string(CDPR_SOURCE_DIR) + "/tests/fuzz/corpus/" + later);
+    ASSERT_TRUE(input.has_value()) << later;
+    const auto refused = parse_robot_toml(*input, "crash.toml");
+    ASSERT_FALSE(refused.has_value()) << later;
+    EXPECT_NE(refused.error().reason.find("non-ASCII"), std::string::npos) << refused.error().message();
+  }
   // AND a robot named with non-ASCII letters still round-trips
   Robot robot;
   robot.name = "Gro\xc3\x9f\xc3\xa9r Roboter";
