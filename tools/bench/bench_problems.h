@@ -28,7 +28,8 @@ const BenchData& bench_data(int pose_count);
 // build_calibration_problem() with default CalibrationOptions; aborts when refused.
 BuiltProblem build_problem(const BenchData& data);
 
-// Our solver's options for the comparison: defaults, 200 iterations like calibrate().
+// Our solver's options for the comparison: defaults, at most kBenchMaxIterations (both solvers).
+inline constexpr int kBenchMaxIterations = 200;
 SolverOptions our_options();
 
 // Ceres' linear solvers worth trying on this problem (its best is what we
