@@ -252,11 +252,10 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
     if (!best) break;
 
     if (options.try_pairs && static_cast<int>(d.steps.size()) + 1 <= options.max_added) {
+      // Still significant: evaluated above its threshold and not rejected as unphysical.
       std::vector<std::size_t> strong;
       for (std::size_t j : order) {
-        if (scores[j].evaluated && scores[j].t_statistic > scores[j].threshold && scores[j].failure.empty()) {
-          strong.push_back(j);
-        }
+        if (scores[j].significant) strong.push_back(j);
       }
       if (std::optional<PairChoice> pair =
               best_pair(robot, samples, options, model, untried, strong, evaluations[*best])) {
@@ -278,8 +277,10 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
         then.t_statistic = c.t_statistic;
         then.threshold = pair->threshold;
         then.significant = true;
-        d.steps.push_back({model, first, fit_all(robot, samples, options, model), std::move(evaluations[pair->first]),
-                           {then}});
+        // The best single's fit on all samples is at hand when it leads the pair.
+        CalibrationResult first_fit =
+            pair->first == *best ? std::move(best_fit) : fit_all(robot, samples, options, model);
+        d.steps.push_back({model, first, std::move(first_fit), std::move(evaluations[pair->first]), {then}});
         model.push_back(second);
         d.steps.push_back({model, second, std::move(pair->fit), std::move(pair->held_out), {}});
         continue;
