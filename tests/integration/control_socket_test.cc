@@ -24,12 +24,16 @@
 namespace cdpr::integration {
 namespace {
 
-TEST(ControlSocket, ConcurrentClientsEachGetTheirAnswersAndStartOneRunOnly) {
-  // GIVEN the daemon against the virtual small robot, its CANopen nodes up
+virtual_robot::VirtualRobotOptions small_robot_five_times_faster() {
   virtual_robot::VirtualRobotOptions options;
   options.preset = sim::Preset::kSmall;
   options.time_scale = 5.0;
-  VirtualRobotRig rig(options);
+  return options;
+}
+
+TEST(ControlSocket, ConcurrentClientsEachGetTheirAnswersAndStartOneRunOnly) {
+  // GIVEN the daemon against the virtual small robot, its CANopen nodes up
+  VirtualRobotRig rig(small_robot_five_times_faster());
   std::this_thread::sleep_for(std::chrono::seconds(1));
 
   // WHEN 8 clients poll status 25 times each while 4 others press start at the same moment
@@ -120,10 +124,7 @@ bool receive_lines(int fd, int lines, std::string& text) {
 
 TEST(ControlSocket, UnderLoadAndAbuseStatusIsServedAndTheRunKeepsStepping) {
   // GIVEN the daemon against the virtual small robot, its CANopen nodes up
-  virtual_robot::VirtualRobotOptions options;
-  options.preset = sim::Preset::kSmall;
-  options.time_scale = 5.0;
-  VirtualRobotRig rig(options);
+  VirtualRobotRig rig(small_robot_five_times_faster());
   std::this_thread::sleep_for(std::chrono::seconds(1));
   const std::string& path = rig.config.control_socket;
 
