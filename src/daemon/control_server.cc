@@ -40,7 +40,9 @@ hal::Status remove_stale_socket(const std::string& path) {
   return hal::Status::Ok();
 }
 
-// The group id of `group`: a group name, or a number.
+// The group id of `group`: a group name, or the number of a group the
+// system knows. A number no group has is refused too: a mistyped id would
+// open the socket to whoever is later given that id.
 hal::Result<gid_t> group_id(const std::string& path, const std::string& group) {
   std::vector<char> buffer(16384);
   struct group entry {};
@@ -49,7 +51,8 @@ hal::Result<gid_t> group_id(const std::string& path, const std::string& group) {
     return found->gr_gid;
   }
   if (group.size() <= 9 && group.find_first_not_of("0123456789") == std::string::npos) {
-    return static_cast<gid_t>(std::strtoul(group.c_str(), nullptr, 10));
+    const auto id = static_cast<gid_t>(std::strtoul(group.c_str(), nullptr, 10));
+    if (getgrgid_r(id, &entry, buffer.data(), buffer.size(), &found) == 0 && found != nullptr) return id;
   }
   return hal::Status(hal::ErrorCode::kInvalidArgument,
                      "control socket " + path + ": group '" + group + "' does not exist");

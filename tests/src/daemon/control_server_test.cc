@@ -18,6 +18,7 @@
 #include <gtest/gtest.h>
 
 #include "src/daemon/control_server.h"
+#include "test_groups.h"
 
 namespace cdpr::daemon {
 namespace {
@@ -259,13 +260,14 @@ int connect_as_nobody(const std::string& path, gid_t gid, bool expect_connected)
 }
 
 TEST(ControlServer, SocketBelongsToTheConfiguredGroupAndOnlyItsMembersConnect) {
-  // GIVEN a server whose socket is given to a group (as root: any group id;
-  // otherwise the test's own group, the only one it may give)
+  // GIVEN a server whose socket is given to a group by its id (as root: any
+  // existing group but our own; otherwise the test's own group, the only one
+  // it may give)
   TempDir dir;
   StubHandler handler;
   const std::string path = dir / "control";
   const bool root = geteuid() == 0;
-  const gid_t operators = root ? 4242 : getegid();
+  const gid_t operators = root ? another_group().value_or(getegid()) : getegid();
   auto server = ControlServer::listen(path, std::ref(handler), 0660, std::to_string(operators));
   ASSERT_TRUE(server.ok()) << server.status().to_string();
   // THEN the socket is that group's, mode 0660
@@ -278,6 +280,13 @@ TEST(ControlServer, SocketBelongsToTheConfiguredGroupAndOnlyItsMembersConnect) {
   ASSERT_FALSE(unknown.ok());
   EXPECT_EQ(unknown.status().code(), hal::ErrorCode::kInvalidArgument);
   EXPECT_NE(unknown.status().message().find("no-such-group-cdpr"), std::string::npos);
+  // AND so is a numeric id no group has (a typo would open the socket to
+  // whoever is given that id later)
+  const std::string unused = std::to_string(unused_group_id());
+  auto unused_id = ControlServer::listen(dir / "third", std::ref(handler), 0660, unused);
+  ASSERT_FALSE(unused_id.ok());
+  EXPECT_NE(unused_id.status().message().find("'" + unused + "' does not exist"), std::string::npos)
+      << unused_id.status().to_string();
   if (!root) GTEST_SKIP() << "connecting as other users needs root";
   // WHEN an unprivileged user in that group, and one outside it, connect
   ASSERT_EQ(chmod(std::filesystem::path(path).parent_path().c_str(), 0755), 0);

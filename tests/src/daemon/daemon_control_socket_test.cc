@@ -22,6 +22,7 @@
 #include "../../solver/test_robots.h"
 #include "../store/store_test_support.h"
 #include "src/daemon/daemon_loop.h"
+#include "test_groups.h"
 
 namespace cdpr::daemon {
 namespace {
@@ -64,29 +65,6 @@ DaemonConfig config_in(const std::string& dir, const std::string& control_lines)
   auto config = parse_daemon_config(text, "cdpr-calibd.toml");
   EXPECT_TRUE(config) << config.error().message();
   return config ? *config : DaemonConfig{};
-}
-
-// A group this process may give a file to other than its own: any group as
-// root, else one of its supplementary groups.
-std::optional<gid_t> another_group() {
-  if (geteuid() == 0) {
-    setgrent();
-    std::optional<gid_t> found;
-    while (const group* entry = getgrent()) {
-      if (entry->gr_gid != getegid()) {
-        found = entry->gr_gid;
-        break;
-      }
-    }
-    endgrent();
-    return found;
-  }
-  std::vector<gid_t> groups(static_cast<std::size_t>(getgroups(0, nullptr)));
-  groups.resize(static_cast<std::size_t>(getgroups(static_cast<int>(groups.size()), groups.data())));
-  for (const gid_t g : groups) {
-    if (g != getegid()) return g;
-  }
-  return std::nullopt;
 }
 
 TEST(DaemonControlSocket, GetsTheConfiguredGroupByNameAndMode0660) {
