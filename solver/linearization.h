@@ -39,6 +39,10 @@ class Linearization {
   // dim and row-major residual_dim x dim Jacobian in `slot` (null if constant).
   int residual_dim(int f) const { return layout_[f].residual_dim; }
   int key_count(int f) const { return layout_[f].key_count; }
+  // Where factor f's keys start in the per-key arrays (f = factor_count(): their total).
+  int key_offset(int f) const {
+    return f < factor_count() ? layout_[f].key_offset : static_cast<int>(key_variable_.size());
+  }
   int key_variable(int f, int k) const { return key_variable_[layout_[f].key_offset + k]; }
   int key_column(int f, int k) const { return key_column_[layout_[f].key_offset + k]; }
   int key_dim(int f, int k) const { return key_dim_[layout_[f].key_offset + k]; }

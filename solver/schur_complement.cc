@@ -7,6 +7,8 @@
 
 #include <Eigen/Core>
 
+#include "solver/dense_kernels.h"
+
 namespace cdpr {
 namespace {
 
@@ -64,9 +66,6 @@ void solve_upper(const double* u, int dim, double* x) {
 
 // B and W are d x m row-major (a row per local column, contiguous over the
 // m coupled global columns), so the work below runs along contiguous rows.
-using Row = Eigen::Map<Eigen::VectorXd>;
-using ConstRow = Eigen::Map<const Eigen::VectorXd>;
-
 // One group's part of the factorisation: U'U = A + D_A / radius,
 // W = U'^-1 B and S -= W'W over its coupled columns (ascending, so into the
 // upper triangle of the n x n S; `first` >= 0 when they are the contiguous
@@ -80,21 +79,10 @@ bool eliminate_group(int dim, const double* a, double* u, const double* b, doubl
     u[j + d * j] += std::clamp(a[j + d * j], min_diagonal, max_diagonal) / radius;
   }
   if (!cholesky_upper<D>(u, d)) return false;
-  // Forward substitution row by row: w_i = (b_i - sum_{p<i} U_pi w_p) / U_ii.
-  for (int i = 0; i < d; ++i) {
-    Row wi(w + i * m, m);
-    wi = ConstRow(b + i * m, m);
-    for (int p = 0; p < i; ++p) wi -= u[p + d * i] * ConstRow(w + p * m, m);
-    wi /= u[i + d * i];
-  }
+  solve_upper_transposed_rows(d, u, m, b, w);
   // S -= W'W (upper triangle).
   if (first >= 0) {
-    // Contiguous columns: one symmetric rank-d update of S's block, which
-    // Eigen blocks and vectorises (its scratch lives on the stack).
-    using WMatrix = Eigen::Matrix<double, (D > 0 ? D : Eigen::Dynamic), Eigen::Dynamic, Eigen::RowMajor>;
-    Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> s_block(s + first + static_cast<std::size_t>(n) * first, m, m,
-                                                                 Eigen::OuterStride<>(n));
-    s_block.selfadjointView<Eigen::Upper>().rankUpdate(Eigen::Map<const WMatrix>(w, d, m).transpose(), -1.0);
+    add_transposed_product(d, m, m, w, m, w, m, s + first + static_cast<std::size_t>(n) * first, n, -1.0, true);
     return true;
   }
   for (int i = 0; i < d; ++i) {
@@ -314,8 +302,18 @@ SchurComplement::SchurComplement(const Problem& problem, std::vector<int> variab
   // Block operations of every factor: each pair of non-constant keys once,
   // oriented so the block lands in an upper triangle or in B.
   op_begin_.reserve(nf + 1);
+  plans_.assign(nf, FactorPlan{});
+  gather_column_.assign(linearization_.key_offset(nf), -1);
+  std::size_t widest = 0, gathered_size = 0;
   for (int f = 0; f < nf; ++f) {
     op_begin_.push_back(static_cast<int>(ops_.size()));
+    if (plan_gathered(f, factor_group[f], group_of)) {
+      const FactorPlan& plan = plans_[f];
+      const std::size_t width = plan.local_count + plan.global_count;
+      widest = std::max(widest, width);
+      gathered_size = std::max(gathered_size, width * linearization_.residual_dim(f));
+      continue;
+    }
     const int nk = linearization_.key_count(f);
     for (int a = 0; a < nk; ++a) {
       for (int b = a; b < nk; ++b) {
@@ -361,9 +359,95 @@ SchurComplement::SchurComplement(const Problem& problem, std::vector<int> variab
     }
   }
   op_begin_.push_back(static_cast<int>(ops_.size()));
+  gathered_.assign(gathered_size, 0.0);
+  gathered_gradient_.assign(widest, 0.0);
+}
+
+bool SchurComplement::plan_gathered(int f, int group, const std::vector<int>& group_of) {
+  const Linearization& lin = linearization_;
+  FactorPlan plan;
+  plan.group = group;
+  int local_end = 0, global_end = 0;
+  bool any_local = false, any_global = false;
+  for (int k = 0; k < lin.key_count(f); ++k) {
+    const int v = lin.key_variable(f, k), column = lin.variable_column(v), d = lin.key_dim(f, k);
+    if (column < 0) continue;
+    if (group_of[v] >= 0) {
+      const int begin = column - groups_[group].column;
+      plan.local_begin = any_local ? std::min(plan.local_begin, begin) : begin;
+      local_end = any_local ? std::max(local_end, begin + d) : begin + d;
+      any_local = true;
+    } else {
+      const int begin = column - local_dim_;
+      plan.global_begin = any_global ? std::min(plan.global_begin, begin) : begin;
+      global_end = any_global ? std::max(global_end, begin + d) : begin + d;
+      any_global = true;
+    }
+  }
+  if (!any_local && !any_global) return false;
+  // B's rows run over the group's coupled columns: the factor's global span
+  // must be a run of them (true when they are contiguous: they include it).
+  if (group >= 0 && any_global && !groups_[group].contiguous) return false;
+  plan.local_count = any_local ? local_end - plan.local_begin : 0;
+  plan.global_count = any_global ? global_end - plan.global_begin : 0;
+  const int width = plan.local_count + plan.global_count;
+  std::vector<bool> filled(width, false);
+  for (int k = 0; k < lin.key_count(f); ++k) {
+    const int v = lin.key_variable(f, k), column = lin.variable_column(v), d = lin.key_dim(f, k);
+    if (column < 0) continue;
+    const int first = group_of[v] >= 0 ? column - groups_[group].column - plan.local_begin
+                                       : plan.local_count + column - local_dim_ - plan.global_begin;
+    for (int c = first; c < first + d; ++c) {
+      if (filled[c]) return false;  // a key listed twice
+      filled[c] = true;
+    }
+    gather_column_[lin.key_offset(f) + k] = first;
+  }
+  plan.gaps = std::find(filled.begin(), filled.end(), false) != filled.end();
+  plan.gathered = true;
+  plans_[f] = plan;
+  return true;
 }
 
 SchurComplement::~SchurComplement() = default;
+
+void SchurComplement::accumulate_gathered(int slot, int f, double* gradient) {
+  const Linearization& lin = linearization_;
+  const FactorPlan& plan = plans_[f];
+  const int m = lin.residual_dim(f), lc = plan.local_count, gc = plan.global_count, width = lc + gc;
+  double* j = gathered_.data();
+  if (plan.gaps) std::fill(j, j + m * width, 0.0);
+  for (int k = 0; k < lin.key_count(f); ++k) {
+    const int first = gather_column_[lin.key_offset(f) + k];
+    if (first < 0) continue;
+    const int d = lin.key_dim(f, k);
+    const double* block = lin.jacobian(slot, f, k);
+    for (int i = 0; i < m; ++i) std::copy(block + i * d, block + (i + 1) * d, j + i * width + first);
+  }
+  // J^T r, then J^T J as its blocks A (local x local), B (local x global,
+  // stored as its transpose, column-major) and C (global x global).
+  double* g = gathered_gradient_.data();
+  std::fill(g, g + width, 0.0);
+  add_transposed_times_vector(m, width, j, width, lin.residuals(slot, f), g);
+  const int n = global_dim_;
+  for (int c = 0; c < gc; ++c) gradient[local_dim_ + plan.global_begin + c] += g[lc + c];
+  if (gc > 0) {
+    add_transposed_product(m, gc, gc, j + lc, width, j + lc, width,
+                           c_.data() + plan.global_begin + static_cast<std::size_t>(n) * plan.global_begin, n, 1.0,
+                           true);
+  }
+  if (lc == 0) return;
+  const Group& group = groups_[plan.group];
+  for (int c = 0; c < lc; ++c) gradient[group.column + plan.local_begin + c] += g[c];
+  add_transposed_product(m, lc, lc, j, width, j, width, a_.data() + group.block + plan.local_begin * (group.dim + 1),
+                         group.dim, 1.0, true);
+  if (gc > 0) {
+    const int coupled = group.coupled_end - group.coupled_begin;
+    const int position = plan.global_begin - coupled_[group.coupled_begin];
+    add_transposed_product(m, gc, lc, j + lc, width, j, width,
+                           b_.data() + group.coupling + position + coupled * plan.local_begin, coupled, 1.0, false);
+  }
+}
 
 void SchurComplement::accumulate(int slot, double* gradient) {
   std::fill(a_.begin(), a_.end(), 0.0);
@@ -373,6 +457,10 @@ void SchurComplement::accumulate(int slot, double* gradient) {
   const Linearization& lin = linearization_;
   double* targets[3] = {a_.data(), b_.data(), c_.data()};
   for (int f = 0; f < lin.factor_count(); ++f) {
+    if (plans_[f].gathered) {
+      accumulate_gathered(slot, f, gradient);
+      continue;
+    }
     const int m = lin.residual_dim(f);
     lin.add_gradient(slot, f, gradient);
     for (int o = op_begin_[f]; o < op_begin_[f + 1]; ++o) {

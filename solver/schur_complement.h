@@ -82,6 +82,9 @@ class SchurComplement {
   };
 
   // group_of[v]: the pose group of variable v, -1 for global or constant ones.
+  // Plans the gathered J^T J of factor f (false: it takes block ops).
+  bool plan_gathered(int f, int group, const std::vector<int>& group_of);
+  void accumulate_gathered(int slot, int f, double* gradient);
   SchurComplement(const Problem& problem, std::vector<int> variable_column, const std::vector<int>& group_of,
                   int group_count);
 
@@ -89,10 +92,28 @@ class SchurComplement {
   int local_dim_ = 0, global_dim_ = 0;
   std::vector<Group> groups_;
   std::vector<int> coupled_;             // global columns (0-based among the globals)
+  // The strictly lower triangles of a_, c_ and s_ are scratch (the dense
+  // kernels may write there); only upper triangles are read.
   std::vector<double> a_, factor_;       // per group: J^T J block (upper), its damped Cholesky factor U (A = U'U)
   std::vector<double> b_, w_;            // per group, row-major: coupling block B, then W = U'^-1 B
   std::vector<double> c_, s_;            // global x global, column-major upper: C, then the reduced S
-  std::vector<BlockOp> ops_;             // per factor, in order
+  // How a factor's J^T J reaches A, B and C. Gathered: its Jacobian blocks
+  // are copied into one row-major residual_dim x width matrix whose columns
+  // are a span of its group's local columns, then a span of global ones, so
+  // its whole J^T J is three dense products written in place (the usual
+  // case). Otherwise (a global span its group does not reach contiguously,
+  // a key listed twice): one block product per pair of keys (ops_).
+  struct FactorPlan {
+    bool gathered = false;
+    int group = -1;                          // -1: no per-pose key
+    int local_begin = 0, local_count = 0;    // within the group's columns
+    int global_begin = 0, global_count = 0;  // among the global columns
+    bool gaps = false;                       // some gathered column no key fills (kept zero)
+  };
+  std::vector<FactorPlan> plans_;        // per factor
+  std::vector<int> gather_column_;       // per factor key (Linearization's order): column in the gathered row, -1 if constant
+  std::vector<double> gathered_, gathered_gradient_;  // scratch of the widest gathered factor
+  std::vector<BlockOp> ops_;             // of the factors not gathered, in order
   std::vector<int> op_begin_;            // per factor into ops_ (+1 at the end)
   std::vector<double> reduced_rhs_;
 };

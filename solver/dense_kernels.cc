@@ -1,0 +1,157 @@
+#include "solver/dense_kernels.h"
+
+#include <algorithm>
+#include <cstring>
+
+namespace cdpr {
+namespace {
+
+// Two doubles in one register where the target has one (SSE2, NEON).
+typedef double Pair __attribute__((vector_size(2 * sizeof(double))));
+
+Pair load(const double* p) {
+  Pair v;
+  std::memcpy(&v, p, sizeof v);  // unaligned: rows start anywhere
+  return v;
+}
+void store(double* p, Pair v) { std::memcpy(p, &v, sizeof v); }
+Pair splat(double a) { return Pair{a, a}; }
+
+// Rows [r, r + 2 Pairs) of columns c .. c + Cols - 1: the x rows are loaded
+// two at a time and multiplied by one broadcast y entry per column, so the
+// sums of a tile stay in registers over the whole depth.
+template <int Pairs, int Cols>
+void tile(int depth, int r, int c, const double* x, int ldx, const double* y, int ldy, double* out, int ldo,
+          double sign) {
+  Pair sum[Pairs][Cols] = {};
+  for (int k = 0; k < depth; ++k) {
+    const double* xk = x + k * ldx + r;
+    const double* yk = y + k * ldy + c;
+    Pair xv[Pairs];
+    for (int p = 0; p < Pairs; ++p) xv[p] = load(xk + 2 * p);
+    for (int q = 0; q < Cols; ++q) {
+      const Pair yv = splat(yk[q]);
+      for (int p = 0; p < Pairs; ++p) sum[p][q] += xv[p] * yv;
+    }
+  }
+  const Pair s = splat(sign);
+  for (int q = 0; q < Cols; ++q) {
+    for (int p = 0; p < Pairs; ++p) {
+      double* o = out + r + 2 * p + ldo * (c + q);
+      store(o, load(o) + s * sum[p][q]);
+    }
+  }
+}
+
+// Row r alone (an odd row count's last row) of columns c .. c + Cols - 1.
+template <int Cols>
+void row_tile(int depth, int r, int c, const double* x, int ldx, const double* y, int ldy, double* out, int ldo,
+              double sign) {
+  double sum[Cols] = {};
+  for (int k = 0; k < depth; ++k) {
+    const double xk = x[k * ldx + r];
+    for (int q = 0; q < Cols; ++q) sum[q] += xk * y[k * ldy + c + q];
+  }
+  for (int q = 0; q < Cols; ++q) out[r + ldo * (c + q)] += sign * sum[q];
+}
+
+Pair swapped(Pair v) { return __builtin_shufflevector(v, v, 1, 0); }
+
+// Rows [r, r + 4) of columns [c, c + 4), the bulk of the work: a pair of x
+// rows times a pair of y columns gives the 2x2 block's diagonal (x * y) and
+// anti-diagonal (x * swapped y) in two products, four loads and two shuffles
+// per depth step for 16 multiply-adds, all 8 sums in registers.
+void tile4x4(int depth, int r, int c, const double* x, int ldx, const double* y, int ldy, double* out, int ldo,
+             double sign) {
+  // Named sums, not arrays: GCC at -O2 keeps arrays of vectors in memory.
+  Pair d00 = {}, d01 = {}, d10 = {}, d11 = {}, a00 = {}, a01 = {}, a10 = {}, a11 = {};
+  for (int k = 0; k < depth; ++k) {
+    const double* xk = x + k * ldx + r;
+    const double* yk = y + k * ldy + c;
+    const Pair x0 = load(xk), x1 = load(xk + 2), y0 = load(yk), y1 = load(yk + 2);
+    const Pair s0 = swapped(y0), s1 = swapped(y1);
+    d00 += x0 * y0;
+    a00 += x0 * s0;
+    d01 += x0 * y1;
+    a01 += x0 * s1;
+    d10 += x1 * y0;
+    a10 += x1 * s0;
+    d11 += x1 * y1;
+    a11 += x1 * s1;
+  }
+  const Pair s = splat(sign);
+  // (x_r y_c, x_r+1 y_c+1) and (x_r y_c+1, x_r+1 y_c) give columns c and c + 1.
+  auto add = [&](int p, int q, Pair diagonal, Pair anti) {
+    double* even = out + r + 2 * p + ldo * (c + 2 * q);
+    double* odd = even + ldo;
+    store(even, load(even) + s * __builtin_shufflevector(diagonal, anti, 0, 3));
+    store(odd, load(odd) + s * __builtin_shufflevector(anti, diagonal, 0, 3));
+  };
+  add(0, 0, d00, a00);
+  add(0, 1, d01, a01);
+  add(1, 0, d10, a10);
+  add(1, 1, d11, a11);
+}
+
+template <int Cols>
+void column_tiles(int depth, int row_end, int c, const double* x, int ldx, const double* y, int ldy, double* out,
+                  int ldo, double sign) {
+  int r = 0;
+  for (; r + 4 <= row_end; r += 4) tile<2, Cols>(depth, r, c, x, ldx, y, ldy, out, ldo, sign);
+  for (; r + 2 <= row_end; r += 2) tile<1, Cols>(depth, r, c, x, ldx, y, ldy, out, ldo, sign);
+  if (r < row_end) row_tile<Cols>(depth, r, c, x, ldx, y, ldy, out, ldo, sign);
+}
+
+}  // namespace
+
+void add_transposed_product(int depth, int rows, int cols, const double* x, int ldx, const double* y, int ldy,
+                            double* out, int ldo, double sign, bool upper) {
+  int c = 0;
+  for (; c + 4 <= cols; c += 4) {
+    const int row_end = upper ? std::min(rows, c + 4) : rows;
+    int r = 0;
+    for (; r + 4 <= row_end; r += 4) tile4x4(depth, r, c, x, ldx, y, ldy, out, ldo, sign);
+    // The last rows (fewer than four) in the pair kernels.
+    column_tiles<2>(depth, row_end - r, c, x + r, ldx, y, ldy, out + r, ldo, sign);
+    column_tiles<2>(depth, row_end - r, c + 2, x + r, ldx, y, ldy, out + r, ldo, sign);
+  }
+  for (; c + 2 <= cols; c += 2) {
+    column_tiles<2>(depth, upper ? std::min(rows, c + 2) : rows, c, x, ldx, y, ldy, out, ldo, sign);
+  }
+  if (c < cols) column_tiles<1>(depth, upper ? std::min(rows, c + 1) : rows, c, x, ldx, y, ldy, out, ldo, sign);
+}
+
+void add_transposed_times_vector(int depth, int cols, const double* x, int ldx, const double* v, double* out) {
+  int c = 0;
+  for (; c + 2 <= cols; c += 2) {
+    Pair sum = {};
+    for (int k = 0; k < depth; ++k) sum += load(x + k * ldx + c) * splat(v[k]);
+    store(out + c, load(out + c) + sum);
+  }
+  if (c < cols) {
+    double sum = 0.0;
+    for (int k = 0; k < depth; ++k) sum += x[k * ldx + c] * v[k];
+    out[c] += sum;
+  }
+}
+
+void solve_upper_transposed_rows(int d, const double* u, int m, const double* b, double* w) {
+  for (int i = 0; i < d; ++i) {
+    double* wi = w + i * m;
+    const double* ui = u + d * i;  // column i of U: U_pi for p <= i
+    const Pair inverse = splat(1.0 / ui[i]);
+    int q = 0;
+    for (; q + 2 <= m; q += 2) {
+      Pair v = load(b + i * m + q);
+      for (int p = 0; p < i; ++p) v -= splat(ui[p]) * load(w + p * m + q);
+      store(wi + q, v * inverse);
+    }
+    if (q < m) {
+      double v = b[i * m + q];
+      for (int p = 0; p < i; ++p) v -= ui[p] * w[p * m + q];
+      wi[q] = v * inverse[0];
+    }
+  }
+}
+
+}  // namespace cdpr
