@@ -121,17 +121,30 @@ void add_transposed_product(int depth, int rows, int cols, const double* x, int 
   if (c < cols) column_tiles<1>(depth, upper ? std::min(rows, c + 1) : rows, c, x, ldx, y, ldy, out, ldo, sign);
 }
 
-void add_transposed_times_vector(int depth, int cols, const double* x, int ldx, const double* v, double* out) {
+void add_transposed_times_vector(int depth, int cols, const double* x, int ldx, const double* v, double sign,
+                                 double* out) {
   int c = 0;
   for (; c + 2 <= cols; c += 2) {
     Pair sum = {};
     for (int k = 0; k < depth; ++k) sum += load(x + k * ldx + c) * splat(v[k]);
-    store(out + c, load(out + c) + sum);
+    store(out + c, load(out + c) + splat(sign) * sum);
   }
   if (c < cols) {
     double sum = 0.0;
     for (int k = 0; k < depth; ++k) sum += x[k * ldx + c] * v[k];
-    out[c] += sum;
+    out[c] += sign * sum;
+  }
+}
+
+void subtract_times_vector(int rows, int cols, const double* x, int ldx, const double* v, double* out) {
+  for (int k = 0; k < rows; ++k) {
+    const double* xk = x + k * ldx;
+    Pair sum = {};
+    int c = 0;
+    for (; c + 2 <= cols; c += 2) sum += load(xk + c) * load(v + c);
+    double dot = sum[0] + sum[1];
+    if (c < cols) dot += xk[c] * v[c];
+    out[k] -= dot;
   }
 }
 

@@ -19,8 +19,12 @@ namespace cdpr {
 void add_transposed_product(int depth, int rows, int cols, const double* x, int ldx, const double* y, int ldy,
                             double* out, int ldo, double sign, bool upper);
 
-// out[c] += sum_{k < depth} x(k, c) v[k] for c < cols (x' v).
-void add_transposed_times_vector(int depth, int cols, const double* x, int ldx, const double* v, double* out);
+// out[c] += sign * sum_{k < depth} x(k, c) v[k] for c < cols (x' v).
+void add_transposed_times_vector(int depth, int cols, const double* x, int ldx, const double* v, double sign,
+                                 double* out);
+
+// out[k] -= sum_{c < cols} x(k, c) v[c] for k < rows (x v).
+void subtract_times_vector(int rows, int cols, const double* x, int ldx, const double* v, double* out);
 
 // W = U'^-1 B for the d x d upper triangular U (column-major) and the
 // d x m row-major B and W (forward substitution, a whole row at a time).

@@ -96,11 +96,16 @@ bool eliminate_group(int dim, const double* a, double* u, const double* b, doubl
 }
 
 // The group's part of a solve, before the reduced system: y = U'^-1 b_l in
-// place, reduced right-hand side -= W'y.
+// place, reduced right-hand side -= W'y (`first` as in eliminate_group).
 template <int D>
-void forward_group(int dim, const double* u, const double* w, int m, const int* columns, double* y, double* reduced) {
+void forward_group(int dim, const double* u, const double* w, int m, const int* columns, int first, double* y,
+                   double* reduced) {
   const int d = D > 0 ? D : dim;
   solve_upper_transposed<D>(u, d, y);
+  if (first >= 0) {
+    add_transposed_times_vector(d, m, w, m, y, -1.0, reduced + first);
+    return;
+  }
   for (int i = 0; i < d; ++i) {
     for (int p = 0; p < m; ++p) reduced[columns[p]] -= w[i * m + p] * y[i];
   }
@@ -108,13 +113,17 @@ void forward_group(int dim, const double* u, const double* w, int m, const int* 
 
 // ... and after it: x_l = U^-1 (y - W x_g) in place.
 template <int D>
-void backward_group(int dim, const double* u, const double* w, int m, const int* columns, const double* x_global,
-                    double* y) {
+void backward_group(int dim, const double* u, const double* w, int m, const int* columns, int first,
+                    const double* x_global, double* y) {
   const int d = D > 0 ? D : dim;
-  for (int i = 0; i < d; ++i) {
-    double dot = 0.0;
-    for (int p = 0; p < m; ++p) dot += w[i * m + p] * x_global[columns[p]];
-    y[i] -= dot;
+  if (first >= 0) {
+    subtract_times_vector(d, m, w, m, x_global + first, y);
+  } else {
+    for (int i = 0; i < d; ++i) {
+      double dot = 0.0;
+      for (int p = 0; p < m; ++p) dot += w[i * m + p] * x_global[columns[p]];
+      y[i] -= dot;
+    }
   }
   solve_upper<D>(u, d, y);
 }
@@ -428,7 +437,7 @@ void SchurComplement::accumulate_gathered(int slot, int f, double* gradient) {
   // stored as its transpose, column-major) and C (global x global).
   double* g = gathered_gradient_.data();
   std::fill(g, g + width, 0.0);
-  add_transposed_times_vector(m, width, j, width, lin.residuals(slot, f), g);
+  add_transposed_times_vector(m, width, j, width, lin.residuals(slot, f), 1.0, g);
   const int n = global_dim_;
   for (int c = 0; c < gc; ++c) gradient[local_dim_ + plan.global_begin + c] += g[lc + c];
   if (gc > 0) {
@@ -443,7 +452,7 @@ void SchurComplement::accumulate_gathered(int slot, int f, double* gradient) {
                          group.dim, 1.0, true);
   if (gc > 0) {
     const int coupled = group.coupled_end - group.coupled_begin;
-    const int position = plan.global_begin - coupled_[group.coupled_begin];
+    const int position = plan.global_begin - group.first_if_contiguous(coupled_);
     add_transposed_product(m, gc, lc, j + lc, width, j, width,
                            b_.data() + group.coupling + position + coupled * plan.local_begin, coupled, 1.0, false);
   }
@@ -489,7 +498,7 @@ FactorizationStatus SchurComplement::factorize(double radius, double min_diagona
     const double* b = b_.data() + g.coupling;
     double* w = w_.data() + g.coupling;
     const int* columns = coupled_.data() + g.coupled_begin;
-    const int first = g.contiguous ? (m > 0 ? columns[0] : 0) : -1;
+    const int first = g.first_if_contiguous(coupled_);
     bool ok = false;
     for_group_dim(d, [&](auto size) {
       constexpr int D = decltype(size)::value;
@@ -530,7 +539,8 @@ void SchurComplement::solve(const double* b, double* x) {
     for_group_dim(g.dim, [&](auto size) {
       constexpr int D = decltype(size)::value;
       forward_group<D>(g.dim, factor_.data() + g.block, w_.data() + g.coupling, g.coupled_end - g.coupled_begin,
-                       coupled_.data() + g.coupled_begin, x + g.column, reduced_rhs_.data());
+                       coupled_.data() + g.coupled_begin, g.first_if_contiguous(coupled_), x + g.column,
+                       reduced_rhs_.data());
     });
   }
   solve_upper_transposed<0>(s_.data(), n, reduced_rhs_.data());
@@ -540,7 +550,7 @@ void SchurComplement::solve(const double* b, double* x) {
     for_group_dim(g.dim, [&](auto size) {
       constexpr int D = decltype(size)::value;
       backward_group<D>(g.dim, factor_.data() + g.block, w_.data() + g.coupling, g.coupled_end - g.coupled_begin,
-                        coupled_.data() + g.coupled_begin, x_global, x + g.column);
+                        coupled_.data() + g.coupled_begin, g.first_if_contiguous(coupled_), x_global, x + g.column);
     });
   }
 }

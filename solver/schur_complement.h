@@ -69,6 +69,11 @@ class SchurComplement {
     int coupled_begin = 0; // into coupled_: the global columns its poses' factors reach, ascending
     int coupled_end = 0;
     bool contiguous = false;  // coupled columns are consecutive
+    // The first coupled column when they are consecutive, else -1.
+    int first_if_contiguous(const std::vector<int>& coupled) const {
+      if (!contiguous) return -1;
+      return coupled_end > coupled_begin ? coupled[coupled_begin] : 0;
+    }
   };
   // One block J_a' J_b of a factor's keys a, b added into `target` at
   // `offset` (column-major, leading dimension `stride`).

@@ -74,8 +74,20 @@ TEST(DenseKernels, TransposedTimesVectorAddsXTransposeV) {
     const RowMajor x = random_matrix(7, cols + 1, rng);
     const Eigen::VectorXd v = Eigen::VectorXd::Random(7);
     Eigen::VectorXd out = Eigen::VectorXd::Random(cols);
-    const Eigen::VectorXd expected = out + x.leftCols(cols).transpose() * v;
-    add_transposed_times_vector(7, cols, x.data(), cols + 1, v.data(), out.data());
+    const Eigen::VectorXd expected = out - 3.0 * x.leftCols(cols).transpose() * v;
+    add_transposed_times_vector(7, cols, x.data(), cols + 1, v.data(), -3.0, out.data());
+    EXPECT_LT((out - expected).cwiseAbs().maxCoeff(), 1e-13);
+  }
+}
+
+TEST(DenseKernels, SubtractTimesVectorSubtractsXV) {
+  std::mt19937 rng(7);
+  for (int cols = 0; cols <= 9; ++cols) {
+    const RowMajor x = random_matrix(5, cols + 2, rng);
+    const Eigen::VectorXd v = Eigen::VectorXd::Random(cols);
+    Eigen::VectorXd out = Eigen::VectorXd::Random(5);
+    const Eigen::VectorXd expected = out - x.leftCols(cols) * v;
+    subtract_times_vector(5, cols, x.data(), cols + 2, v.data(), out.data());
     EXPECT_LT((out - expected).cwiseAbs().maxCoeff(), 1e-13);
   }
 }
