@@ -34,14 +34,7 @@ std::string check_effects(const CalibrationOptions& options) {
   if (!options.effects.empty() && options.cable_model != CableModelKind::kCatenary) {
     return "model terms (effects) need the catenary cable model";
   }
-  for (std::size_t a = 0; a < options.effects.size(); ++a) {
-    for (std::size_t b = a + 1; b < options.effects.size(); ++b) {
-      if (options.effects[a] == options.effects[b]) {
-        return "model term " + std::string(effect_model_name(options.effects[a])) + " given twice";
-      }
-    }
-  }
-  return {};
+  return effect_set_conflict(options.effects);
 }
 
 // Data-driven start for one pose: the paper's force guess refined with the

@@ -28,6 +28,23 @@ std::string model_text(const std::vector<Effect>& model) {
   return text;
 }
 
+// The model with effect e added; e replaces a narrower effect it contains
+// (load_cell replaces load_cell_bias: the gain is then the addition).
+std::vector<Effect> with_effect(const std::vector<Effect>& model, Effect e) {
+  std::vector<Effect> with;
+  for (Effect m : model) {
+    if (!effect_contains(e, m)) with.push_back(m);
+  }
+  with.push_back(e);
+  return with;
+}
+
+// Whether adding e to the model would add anything: not when the model has it
+// or an effect that contains it.
+bool can_add(const std::vector<Effect>& model, Effect e) {
+  return std::none_of(model.begin(), model.end(), [e](Effect m) { return m == e || effect_contains(m, e); });
+}
+
 std::string fixed(double value, int digits) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.*f", digits, value);
@@ -130,14 +147,15 @@ std::optional<PairChoice> best_pair(const Robot& robot, const std::vector<Sample
   std::optional<PairChoice> best;
   for (std::size_t a = 0; a < strong.size(); ++a) {
     for (std::size_t b = a + 1; b < strong.size(); ++b) {
-      std::vector<Effect> with = model;
-      with.push_back(candidates[strong[a]]);
-      with.push_back(candidates[strong[b]]);
+      const Effect first = candidates[strong[a]], second = candidates[strong[b]];
+      // Two forms of one term are no pair (load_cell and load_cell_bias).
+      if (effect_contains(first, second) || effect_contains(second, first)) continue;
+      const std::vector<Effect> with = with_effect(with_effect(model, first), second);
       HeldOutEvaluation f = cross_validate(robot, samples, options, with);
       if (!f.ok) continue;
       const HeldOutComparison c = compare_held_out(best_single, f);
-      report(options, "  try pair " + std::string(effect_model_name(with[with.size() - 2])) + " + " +
-                          std::string(effect_model_name(with.back())) + ": held-out chi2 drop " + fixed(c.drop, 1) +
+      report(options, "  try pair " + std::string(effect_model_name(first)) + " + " +
+                          std::string(effect_model_name(second)) + ": held-out chi2 drop " + fixed(c.drop, 1) +
                           " against the best single, paired t " + fixed(c.t_statistic, 2) + " (needs > " +
                           fixed(threshold, 2) + ")");
       if (c.t_statistic <= threshold || 2 * c.paired_poses < static_cast<int>(best_single.poses.size())) continue;
@@ -189,16 +207,14 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
   while (static_cast<int>(d.steps.size()) - 1 < options.max_added) {
     std::vector<Effect> untried;
     for (Effect e : options.candidates) {
-      if (std::find(model.begin(), model.end(), e) == model.end()) untried.push_back(e);
+      if (can_add(model, e)) untried.push_back(e);
     }
     if (untried.empty()) break;
     const double level = options.alpha / static_cast<double>(untried.size());
     std::vector<CandidateScore> scores;
     std::vector<HeldOutEvaluation> evaluations;
     for (Effect e : untried) {
-      std::vector<Effect> with = model;
-      with.push_back(e);
-      HeldOutEvaluation f = cross_validate(robot, samples, options, with);
+      HeldOutEvaluation f = cross_validate(robot, samples, options, with_effect(model, e));
       CandidateScore score;
       score.effect = e;
       score.threshold = normal_upper_quantile(level);
@@ -235,9 +251,7 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
     CalibrationResult best_fit;
     for (std::size_t j : order) {
       if (!scores[j].significant) break;
-      std::vector<Effect> with = model;
-      with.push_back(scores[j].effect);
-      CalibrationResult fit = fit_all(robot, samples, options, with);
+      CalibrationResult fit = fit_all(robot, samples, options, with_effect(model, scores[j].effect));
       const std::string why = domain_violation(fit, 1);
       if (why.empty()) {
         best = j;
@@ -261,7 +275,7 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
               best_pair(robot, samples, options, model, untried, strong, evaluations[*best])) {
         // Two steps, so that each effect is named with the misfit it removes.
         const Effect first = untried[pair->first], second = untried[pair->second];
-        model.push_back(first);
+        model = with_effect(model, first);
         report(options, "add pair " + std::string(effect_model_name(first)) + " + " +
                             std::string(effect_model_name(second)) + ": held-out normalized rms " +
                             fixed(d.steps.back().held_out.normalized_rms(), 3) + " -> " +
@@ -281,13 +295,13 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
         CalibrationResult first_fit =
             pair->first == *best ? std::move(best_fit) : fit_all(robot, samples, options, model);
         d.steps.push_back({model, first, std::move(first_fit), std::move(evaluations[pair->first]), {then}});
-        model.push_back(second);
+        model = with_effect(model, second);
         d.steps.push_back({model, second, std::move(pair->fit), std::move(pair->held_out), {}});
         continue;
       }
     }
 
-    model.push_back(scores[*best].effect);
+    model = with_effect(model, scores[*best].effect);
     report(options, "add " + std::string(effect_model_name(scores[*best].effect)) + ": held-out normalized rms " +
                         fixed(d.steps.back().held_out.normalized_rms(), 3) + " -> " +
                         fixed(evaluations[*best].normalized_rms(), 3));

@@ -19,7 +19,8 @@
 // (solver/effects.h effect_domain_violation) is rejected, not added. Greedy
 // single steps can be led astray when one effect mimics two others together,
 // so a round with a significant candidate also tries pairs of them
-// (DiagnosisOptions::try_pairs).
+// (DiagnosisOptions::try_pairs). A candidate that contains an effect of the
+// model (load_cell contains load_cell_bias) replaces it when added.
 // Pure numerics: progress goes through a callback.
 
 #include <functional>

@@ -84,6 +84,7 @@ bool EffectPoseFactor::evaluate_model(const double* const* parameters, double* r
                                       PosePrediction* prediction) const {
   const double* scale = effect_parameter(parameters, Effect::kEncoderScale);
   const double* load_cell = effect_parameter(parameters, Effect::kLoadCell);  // (bias, gain)
+  const double* bias_only = effect_parameter(parameters, Effect::kLoadCellBias);
   const double* com = effect_parameter(parameters, Effect::kComOffset);
   const double* density = effect_parameter(parameters, Effect::kDensityError);
   const double* kappa = effect_parameter(parameters, Effect::kElasticity);
@@ -155,7 +156,10 @@ bool EffectPoseFactor::evaluate_model(const double* const* parameters, double* r
   const double tension = in.reference_force.norm();
   const double force_gain = 1.0 + (load_cell ? load_cell[1] : 0.0);
   const double sigma_force = robot_.noise.force_n;
-  residual[force_row] = (force_gain * tension + (load_cell ? load_cell[0] : 0.0) - force_n_) / sigma_force;
+  // The two biases add, so the Jacobians stay exact even for a model that has
+  // both (calibrate() refuses one; the factor need not).
+  const double bias = (load_cell ? load_cell[0] : 0.0) + (bias_only ? bias_only[0] : 0.0);
+  residual[force_row] = (force_gain * tension + bias - force_n_) / sigma_force;
   if (prediction) prediction->force_residual_n = residual[force_row] * sigma_force;
   if (with_jacobian) {
     StatRow row = StatRow::Zero();
@@ -168,6 +172,7 @@ bool EffectPoseFactor::evaluate_model(const double* const* parameters, double* r
       J[force_row * 2] = 1.0 / sigma_force;
       J[force_row * 2 + 1] = tension / sigma_force;
     }
+    if (double* J = effect_jacobian(jacobians, Effect::kLoadCellBias)) J[force_row] = 1.0 / sigma_force;
   }
   return true;
 }

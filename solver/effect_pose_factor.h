@@ -4,7 +4,7 @@
 // (solver/effects.h), each read from its own EffectKey variable:
 //   encoder i:  ((1 + s_i) payout_i + l0_i - z_enc,i) / sigma_encoder
 //   height i:   (b_z,i - z_i) / sigma_height
-//   force:      ((1 + g) |(f_h, f_v)_ref| + b - z_force) / sigma_force
+//   force:      ((1 + g) |(f_h, f_v)_ref| + b - z_force) / sigma_force (b of load_cell or load_cell_bias)
 // payout_i and z_i from solver/effect_cable.h (elasticity, density error,
 // swivel pulley), the statics with the weight at the nominal CoM + c.
 // With no effects it is the base catenary model (payout = arc length).

@@ -12,6 +12,7 @@ std::string_view effect_model_name(Effect e) {
     case Effect::kComOffset: return "com_offset";
     case Effect::kDensityError: return "density_error";
     case Effect::kPulleyRadius: return "pulley_radius";
+    case Effect::kLoadCellBias: return "load_cell_bias";
   }
   return "?";
 }
@@ -19,6 +20,7 @@ std::string_view effect_model_name(Effect e) {
 std::vector<std::string> effect_value_names(Effect e) {
   if (e == Effect::kElasticity) return {"axial_stiffness"};
   if (e == Effect::kLoadCell) return {"force_bias", "force_gain"};
+  if (e == Effect::kLoadCellBias) return {"force_bias"};
   return {std::string(effect_model_name(e))};
 }
 
@@ -46,8 +48,26 @@ std::string_view effect_description(Effect e) {
     case Effect::kComOffset: return "centre-of-mass offset: the weight acts at the nominal CoM + c";
     case Effect::kDensityError: return "cable density error: density = nominal (1 + r)";
     case Effect::kPulleyRadius: return "swivel-pulley radius: the cable wraps a pulley of radius r at the anchor";
+    case Effect::kLoadCellBias: return "load-cell bias alone (gain right): reading = tension + b";
   }
   return "?";
+}
+
+bool effect_contains(Effect wide, Effect narrow) {
+  return wide == Effect::kLoadCell && narrow == Effect::kLoadCellBias;
+}
+
+std::string effect_set_conflict(const std::vector<Effect>& effects) {
+  for (std::size_t a = 0; a < effects.size(); ++a) {
+    for (std::size_t b = a + 1; b < effects.size(); ++b) {
+      const std::string first(effect_model_name(effects[a])), second(effect_model_name(effects[b]));
+      if (effects[a] == effects[b]) return "model term " + first + " given twice";
+      if (effect_contains(effects[a], effects[b]) || effect_contains(effects[b], effects[a])) {
+        return "model terms " + first + " and " + second + " share a parameter: give one of them";
+      }
+    }
+  }
+  return {};
 }
 
 std::string effect_domain_violation(Effect e, const std::vector<double>& value, const std::vector<double>& sigma) {

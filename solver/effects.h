@@ -10,8 +10,13 @@
 //   encoder_scale  s_i (4)                   reading = (1 + s_i) * payout + offset_i
 //   load_cell      (b [N], g)                load cell reads (1 + g) * tension + b
 //                                            ([effects] force_bias, force_gain: one term, as in
-//                                            DESIGN.md, since over the tensions of a calibration
-//                                            a bias and a gain are hard to tell apart)
+//                                            DESIGN.md)
+//   load_cell_bias b [N]                     the same term with g = 0 ([effects] force_bias
+//                                            only). Over the tensions of a calibration b and g
+//                                            are nearly collinear, so fitting both leaves b
+//                                            with a sigma near its own size (about 10 N at
+//                                            45 poses); a load cell whose gain is right is
+//                                            named and measured far better by b alone
 //   com_offset     c (3) [m, platform frame] weight acts at nominal CoM + c
 //   density_error  r                         cable density = nominal * (1 + r)
 //   pulley_radius  r [m]                     swivel pulley (DESIGN.md)
@@ -34,11 +39,12 @@ enum class Effect : int {
   kComOffset,
   kDensityError,
   kPulleyRadius,
+  kLoadCellBias,
 };
-inline constexpr int kEffectCount = 6;
+inline constexpr int kEffectCount = 7;
 inline constexpr std::array<Effect, kEffectCount> kAllEffects = {
-    Effect::kElasticity, Effect::kEncoderScale, Effect::kLoadCell,
-    Effect::kComOffset,  Effect::kDensityError, Effect::kPulleyRadius};
+    Effect::kElasticity,   Effect::kEncoderScale,  Effect::kLoadCell,    Effect::kComOffset,
+    Effect::kDensityError, Effect::kPulleyRadius, Effect::kLoadCellBias};
 
 // Compliance unit of the elasticity parameter: kappa [1/MN] = 1e6 / EA [N].
 inline constexpr double kComplianceScale = 1e-6;
@@ -47,7 +53,7 @@ inline Key EffectKey(Effect e) { return EffectKey(static_cast<int>(e)); }
 
 // Name in `model = [...]` and on the command line: "elasticity",
 // "encoder_scale", "load_cell", "com_offset",
-// "density_error", "pulley_radius".
+// "density_error", "pulley_radius", "load_cell_bias".
 std::string_view effect_model_name(Effect e);
 std::optional<Effect> effect_from_model_name(std::string_view name);
 // Size of the effect's parameter vector (1 to 4).
@@ -68,5 +74,12 @@ void add_effect_values(Effect e, const std::vector<double>& parameter, const std
 std::string effect_domain_violation(Effect e, const std::vector<double>& value, const std::vector<double>& sigma);
 // The [effects] names of the effect's physical values, in add_effect_values order.
 std::vector<std::string> effect_value_names(Effect e);
+// True when every parameter of `narrow` is also one of `wide`'s (load_cell
+// holds load_cell_bias's bias), so that one model cannot have both: `wide`
+// replaces `narrow` when added to a model that has it.
+bool effect_contains(Effect wide, Effect narrow);
+// Why a model's effects cannot be fitted together (an effect given twice, or
+// two that share a parameter), or empty.
+std::string effect_set_conflict(const std::vector<Effect>& effects);
 
 }  // namespace cdpr

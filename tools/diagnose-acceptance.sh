@@ -89,14 +89,14 @@ echo "| case (hidden in the data)    | expected named             | named | in 3
 echo "|---|---|---|---|---|---|---|---|---|"
 run_case "EA 1.5e6 N" elasticity 11 "$seeds" large --axial-stiffness 1.5e6
 run_case "encoder scale 0.3 %" encoder_scale 11 "$seeds" large --encoder-scale 0.003
-run_case "load-cell bias 15 N" load_cell 11 "$seeds" large --force-bias 15
+run_case "load-cell bias 15 N" load_cell_bias 11 "$seeds" large --force-bias 15
 run_case "CoM offset 5 cm" com_offset 11 "$seeds" large --com-offset 0.03,0.04,0
 run_case "pulley radius 0.15 m (small robot)" pulley_radius 11 "$seeds" small --pulley-radius 0.15
 run_case "density error 5 %" density_error 11 "$seeds" large --density-error 0.05
 run_case "none (false positives)" none 101 "$null_seeds" large
 run_case "none, small robot (false pos.)" none 101 "$null_seeds" small
-run_case "EA 1.5e6 N + bias 15 N" elasticity,load_cell 11 "$seeds" large --axial-stiffness 1.5e6 --force-bias 15
-run_case "enc. scale 0.3 % + bias 15 N" encoder_scale,load_cell 11 "$seeds" large --encoder-scale 0.003 --force-bias 15
+run_case "EA 1.5e6 N + bias 15 N" elasticity,load_cell_bias 11 "$seeds" large --axial-stiffness 1.5e6 --force-bias 15
+run_case "enc. scale 0.3 % + bias 15 N" encoder_scale,load_cell_bias 11 "$seeds" large --encoder-scale 0.003 --force-bias 15
 run_case "EA 1.5e6 N + CoM 5 cm" elasticity,com_offset 11 "$seeds" large --axial-stiffness 1.5e6 --com-offset 0.03,0.04,0
 run_case "wind 36 N (unknown)" none 11 "$seeds" large --wind 30,20,0
 run_case "wind 72 N (unknown)" none 11 "$seeds" large --wind 60,40,0

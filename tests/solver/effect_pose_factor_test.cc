@@ -20,6 +20,7 @@ std::vector<double> effect_value(Effect e) {
     case Effect::kComOffset: return {0.05, -0.03, 0.02};
     case Effect::kDensityError: return {0.05};
     case Effect::kPulleyRadius: return {0.15};
+    case Effect::kLoadCellBias: return {15.0};
   }
   return {};
 }

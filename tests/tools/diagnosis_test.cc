@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <tuple>
 #include <utility>
 
@@ -46,23 +47,68 @@ Diagnosis run(const sim::DatasetConfig& config) {
   return d;
 }
 
+// The workflow added `effect` alone, and the final fit's [effects] value
+// `name` is within 3 sigma of `truth`.
+void expect_named_alone_within_three_sigma(const Diagnosis& d, Effect effect, const std::string& name, double truth) {
+  ASSERT_EQ(d.steps.size(), 2u) << "expected exactly one effect added";
+  EXPECT_EQ(d.steps[1].added, effect);
+  ASSERT_TRUE(d.final_fit.ok);
+  const EffectValues& fitted = d.final_fit.calibration.effects;
+  ASSERT_TRUE(fitted.count(name) && fitted.count(name + "_sigma")) << name;
+  EXPECT_LT(std::abs(fitted.at(name)[0] - truth), 3.0 * fitted.at(name + "_sigma")[0]) << name;
+}
+
 TEST(Diagnosis, NamesHiddenElasticityAndRecoversEaWithinThreeSigma) {
   // GIVEN cables with EA = 1.5e6 N that the nominal robot calls inextensible
   sim::DatasetConfig config = large_robot(2);
   config.effects.axial_stiffness_n = 1.5e6;
   // WHEN the workflow runs
   const Diagnosis d = run(config);
-  ASSERT_EQ(d.steps.size(), 2u) << "expected exactly one effect added";
   // THEN it adds elasticity, the fitted EA is within 3 sigma of the truth,
   // the held-out misfit shrinks and no unexplained structure is claimed
-  EXPECT_EQ(d.steps[1].added, Effect::kElasticity);
-  const EffectValues& fitted = d.steps[1].fit.calibration.effects;
-  ASSERT_TRUE(fitted.count("axial_stiffness") && fitted.count("axial_stiffness_sigma"));
-  EXPECT_LT(std::abs(fitted.at("axial_stiffness")[0] - 1.5e6), 3.0 * fitted.at("axial_stiffness_sigma")[0]);
+  expect_named_alone_within_three_sigma(d, Effect::kElasticity, "axial_stiffness", 1.5e6);
+  ASSERT_EQ(d.steps.size(), 2u);
   EXPECT_LT(d.steps[1].held_out.normalized_rms(), d.steps[0].held_out.normalized_rms());
   EXPECT_FALSE(d.structure_remains);
   ASSERT_TRUE(d.final_fit.ok);
   EXPECT_EQ(d.final_fit.calibration.model, (std::vector<std::string>{"catenary", "elasticity"}));
+}
+
+TEST(Diagnosis, NamesALoadCellBiasAloneWhenTheGainIsRight) {
+  // GIVEN a load cell reading 15 N high, its gain right, 45 poses: with the
+  // gain fitted too, the bias's sigma is near its own size
+  sim::DatasetConfig config = large_robot(13);
+  config.effects.force_bias_n = 15.0;
+  // WHEN the workflow runs
+  const Diagnosis d = run(config);
+  // THEN it names the bias alone and recovers it within 3 sigma
+  expect_named_alone_within_three_sigma(d, Effect::kLoadCellBias, "force_bias", 15.0);
+  EXPECT_FALSE(d.final_fit.calibration.effects.count("force_gain"));
+  EXPECT_EQ(d.final_fit.calibration.model, (std::vector<std::string>{"catenary", "load_cell_bias"}));
+}
+
+TEST(Diagnosis, ALoadCellGainReplacesTheBiasAloneInTheModel) {
+  // GIVEN a load cell with a 5 % gain error and a 15 N bias, and a starting
+  // model that already fits the bias alone
+  sim::DatasetConfig config = large_robot(11);
+  config.pose_count = 90;
+  config.effects.force_bias_n = 15.0;
+  config.effects.force_gain = 0.05;
+  auto data = sim::simulate_dataset(config);
+  ASSERT_TRUE(data) << data.error();
+  DiagnosisOptions options;
+  options.fit.effects = {Effect::kLoadCellBias};
+  // WHEN the workflow runs
+  const Diagnosis d = diagnose(data->nominal, data->samples, options);
+  ASSERT_TRUE(d.ok) << d.message;
+  // THEN load_cell (bias and gain) takes the place of the bias alone: the
+  // model never holds both, and the gain is recovered within 3 sigma
+  ASSERT_GE(d.steps.size(), 2u);
+  EXPECT_EQ(d.steps[1].added, Effect::kLoadCell);
+  EXPECT_EQ(d.steps[1].model, std::vector<Effect>{Effect::kLoadCell});
+  const EffectValues& fitted = d.steps[1].fit.calibration.effects;
+  ASSERT_TRUE(fitted.count("force_gain") && fitted.count("force_gain_sigma"));
+  EXPECT_LT(std::abs(fitted.at("force_gain")[0] - 0.05), 3.0 * fitted.at("force_gain_sigma")[0]);
 }
 
 TEST(Diagnosis, FindsElasticityAndLoadCellBiasTogetherThoughADensityErrorMimicsBoth) {
@@ -97,11 +143,7 @@ TEST(Diagnosis, NamesASwivelPulleyOnTheSmallRobotPosedOverItsFootprint) {
   // WHEN the workflow runs
   const Diagnosis d = run(config);
   // THEN it names the pulley alone and recovers its radius within 3 sigma
-  ASSERT_EQ(d.steps.size(), 2u);
-  EXPECT_EQ(d.steps[1].added, Effect::kPulleyRadius);
-  const EffectValues& fitted = d.final_fit.calibration.effects;
-  ASSERT_TRUE(fitted.count("pulley_radius") && fitted.count("pulley_radius_sigma"));
-  EXPECT_LT(std::abs(fitted.at("pulley_radius")[0] - 0.15), 3.0 * fitted.at("pulley_radius_sigma")[0]);
+  expect_named_alone_within_three_sigma(d, Effect::kPulleyRadius, "pulley_radius", 0.15);
 }
 
 TEST(Diagnosis, AddsNothingWhenNothingIsHidden) {

@@ -60,5 +60,26 @@ TEST(EffectModel, EncoderScaleComOffsetAndLoadCellGainReproduceTheSimulator) {
   expect_exact_recovery(config, {Effect::kEncoderScale, Effect::kComOffset, Effect::kLoadCell});
 }
 
+TEST(EffectModel, LoadCellBiasAloneReproducesTheSimulator) {
+  // GIVEN a load cell reading 15 N high with its gain right, and elastic cables
+  sim::DatasetConfig config = noiseless_large();
+  config.effects.force_bias_n = 15.0;
+  config.effects.axial_stiffness_n = 1.5e6;
+  // WHEN fitted with the bias alone (no gain term), THEN the readings and the truth come back exactly
+  expect_exact_recovery(config, {Effect::kElasticity, Effect::kLoadCellBias});
+}
+
+TEST(EffectModel, RefusesTwoFormsOfTheLoadCellTermInOneModel) {
+  // GIVEN a model with both load_cell (bias and gain) and load_cell_bias, whose biases could not be told apart
+  auto data = sim::simulate_dataset(noiseless_large());
+  ASSERT_TRUE(data) << data.error();
+  CalibrationOptions options;
+  options.effects = {Effect::kLoadCellBias, Effect::kElasticity, Effect::kLoadCell};
+  // WHEN calibrating, THEN it refuses, naming both terms
+  const CalibrationResult result = calibrate(data->nominal, data->samples, options);
+  EXPECT_FALSE(result.ok);
+  EXPECT_NE(result.message.find("load_cell_bias and load_cell share a parameter"), std::string::npos) << result.message;
+}
+
 }  // namespace
 }  // namespace cdpr

@@ -1,6 +1,5 @@
 #include "model_option.h"
 
-#include <algorithm>
 #include <sstream>
 
 namespace cdpr::tools {
@@ -18,10 +17,8 @@ std::optional<ModelChoice> parse_model(const std::string& text, std::string* why
     if (first && (name == "catenary" || name == "rigid")) {
       choice.cable_model = name == "rigid" ? CableModelKind::kRigid : CableModelKind::kCatenary;
     } else if (const std::optional<Effect> e = effect_from_model_name(name)) {
-      if (std::find(choice.effects.begin(), choice.effects.end(), *e) != choice.effects.end()) {
-        return fail("model term '" + name + "' given twice");
-      }
       choice.effects.push_back(*e);
+      if (const std::string conflict = effect_set_conflict(choice.effects); !conflict.empty()) return fail(conflict);
     } else {
       return fail("unknown model or term '" + name + "' (models: catenary, rigid; terms: " + effect_names_text() + ")");
     }
