@@ -149,20 +149,35 @@ void subtract_times_vector(int rows, int cols, const double* x, int ldx, const d
 }
 
 void solve_upper_transposed_rows(int d, const double* u, int m, const double* b, double* w) {
-  for (int i = 0; i < d; ++i) {
-    double* wi = w + i * m;
-    const double* ui = u + d * i;  // column i of U: U_pi for p <= i
-    const Pair inverse = splat(1.0 / ui[i]);
-    int q = 0;
-    for (; q + 2 <= m; q += 2) {
-      Pair v = load(b + i * m + q);
-      for (int p = 0; p < i; ++p) v -= splat(ui[p]) * load(w + p * m + q);
-      store(wi + q, v * inverse);
+  int q = 0;
+  // Eight columns at a time, their four pairs in registers down all d rows.
+  for (; q + 8 <= m; q += 8) {
+    for (int i = 0; i < d; ++i) {
+      const double* ui = u + d * i;  // column i of U: U_pi for p <= i
+      const double* bi = b + i * m + q;
+      Pair v0 = load(bi), v1 = load(bi + 2), v2 = load(bi + 4), v3 = load(bi + 6);
+      for (int p = 0; p < i; ++p) {
+        const Pair factor = splat(ui[p]);
+        const double* wp = w + p * m + q;
+        v0 -= factor * load(wp);
+        v1 -= factor * load(wp + 2);
+        v2 -= factor * load(wp + 4);
+        v3 -= factor * load(wp + 6);
+      }
+      const Pair inverse = splat(1.0 / ui[i]);
+      double* wi = w + i * m + q;
+      store(wi, v0 * inverse);
+      store(wi + 2, v1 * inverse);
+      store(wi + 4, v2 * inverse);
+      store(wi + 6, v3 * inverse);
     }
-    if (q < m) {
+  }
+  for (; q < m; ++q) {
+    for (int i = 0; i < d; ++i) {
+      const double* ui = u + d * i;
       double v = b[i * m + q];
       for (int p = 0; p < i; ++p) v -= ui[p] * w[p * m + q];
-      wi[q] = v * inverse[0];
+      w[i * m + q] = v * (1.0 / ui[i]);
     }
   }
 }

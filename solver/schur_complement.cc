@@ -431,7 +431,11 @@ void SchurComplement::accumulate_gathered(int slot, int f, double* gradient) {
     if (first < 0) continue;
     const int d = lin.key_dim(f, k);
     const double* block = lin.jacobian(slot, f, k);
-    for (int i = 0; i < m; ++i) std::copy(block + i * d, block + (i + 1) * d, j + i * width + first);
+    // Rows of 1 to 6 values: a plain loop (std::copy calls memmove for each).
+    for (int i = 0; i < m; ++i) {
+      double* row = j + i * width + first;
+      for (int c = 0; c < d; ++c) row[c] = block[i * d + c];
+    }
   }
   // J^T r, then J^T J as its blocks A (local x local), B (local x global,
   // stored as its transpose, column-major) and C (global x global).

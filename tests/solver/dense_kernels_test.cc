@@ -95,7 +95,7 @@ TEST(DenseKernels, SubtractTimesVectorSubtractsXV) {
 TEST(DenseKernels, RowWiseForwardSubstitutionSolvesUTransposedW) {
   std::mt19937 rng(6);
   for (int d : {1, 2, 6, 8}) {
-    for (int m : {1, 2, 3, 16}) {
+    for (int m : {1, 2, 3, 8, 11, 16, 19}) {
       // GIVEN an upper triangular U with a strong diagonal and B (d x m)
       Eigen::MatrixXd u = Eigen::MatrixXd::Random(d, d).triangularView<Eigen::Upper>();
       u.diagonal().array() += 3.0;
