@@ -5,22 +5,11 @@
 #include <cstdio>
 #include <optional>
 
+#include "solver/fit_comparison.h"
 #include "solver/held_out_comparison.h"
 
 namespace cdpr {
 namespace {
-
-double normal_upper_tail(double z) { return 0.5 * std::erfc(z / std::sqrt(2.0)); }
-
-// z with P(Z > z) = p, by bisection (monotone, no need for speed here).
-double normal_upper_quantile(double p) {
-  double lo = -40.0, hi = 40.0;
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (normal_upper_tail(mid) > p ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
 
 std::string model_text(const std::vector<Effect>& model) {
   std::string text = "catenary";
@@ -48,6 +37,12 @@ bool can_add(const std::vector<Effect>& model, Effect e) {
 std::string fixed(double value, int digits) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.*f", digits, value);
+  return buffer;
+}
+
+std::string scientific(double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.2g", value);
   return buffer;
 }
 
@@ -126,26 +121,31 @@ struct PairChoice {
   HeldOutEvaluation held_out;
   CalibrationResult fit;
   HeldOutComparison against_best;
-  double threshold = 0.0;
+  FitComparison over_first;  // the second term on top of the first, on all samples
+  double level = 0.0;
 };
 
 // The pair of the round's individually significant candidates (`strong`,
-// best single drop first) that predicts the held-out poses better than the
-// best single candidate (`best_single`) by the largest drop, if that gain is
-// significant at alpha over the number of pairs and both fitted values are
-// physical. Two effects can each be mimicked in part by a third (a cable
-// elasticity and a load-cell bias together look much like a cable density
-// error), and then the greedy single step takes the mimic and neither true
-// effect is significant on top of it.
+// best single drop first, strong[0] the best single; `single_fits` their fits
+// on all samples) without the best single that predicts the held-out poses
+// better than the best single (`best_single`) by the largest drop, if each of its two terms is
+// significant on top of the other (likelihood ratio on all samples at alpha
+// over the number of pairs) and both fitted values are physical. Two effects
+// can each be mimicked in part by a third (a cable elasticity and a load-cell
+// bias together look much like a cable density error), and then the greedy
+// single step takes the mimic and neither true effect is significant on top
+// of it. A pair with the best single is what the greedy steps try anyway,
+// with every candidate for the second step rather than the strong ones only.
 std::optional<PairChoice> best_pair(const Robot& robot, const std::vector<Sample>& samples,
                                     const DiagnosisOptions& options, const std::vector<Effect>& model,
                                     const std::vector<Effect>& candidates, const std::vector<std::size_t>& strong,
+                                    const std::vector<CalibrationResult>& single_fits,
                                     const HeldOutEvaluation& best_single) {
-  const std::size_t pairs = strong.size() * (strong.size() - 1) / 2;
-  if (pairs == 0) return std::nullopt;
-  const double threshold = normal_upper_quantile(options.alpha / static_cast<double>(pairs));
+  if (strong.size() < 3) return std::nullopt;
+  const std::size_t pairs = (strong.size() - 1) * (strong.size() - 2) / 2;
+  const double level = options.alpha / static_cast<double>(pairs);
   std::optional<PairChoice> best;
-  for (std::size_t a = 0; a < strong.size(); ++a) {
+  for (std::size_t a = 1; a < strong.size(); ++a) {
     for (std::size_t b = a + 1; b < strong.size(); ++b) {
       const Effect first = candidates[strong[a]], second = candidates[strong[b]];
       // Two forms of one term are no pair (load_cell and load_cell_bias).
@@ -154,31 +154,32 @@ std::optional<PairChoice> best_pair(const Robot& robot, const std::vector<Sample
       HeldOutEvaluation f = cross_validate(robot, samples, options, with);
       if (!f.ok) continue;
       const HeldOutComparison c = compare_held_out(best_single, f);
+      CalibrationResult fit = fit_all(robot, samples, options, with);
+      const FitComparison over_first = compare_fits(single_fits[strong[a]], fit);
+      const FitComparison over_second = compare_fits(single_fits[strong[b]], fit);
       report(options, "  try pair " + std::string(effect_model_name(first)) + " + " +
                           std::string(effect_model_name(second)) + ": held-out chi2 drop " + fixed(c.drop, 1) +
-                          " against the best single, paired t " + fixed(c.t_statistic, 2) + " (needs > " +
-                          fixed(threshold, 2) + ")");
-      if (c.t_statistic <= threshold || 2 * c.paired_poses < static_cast<int>(best_single.poses.size())) continue;
+                          " against the best single; on all samples p " + scientific(over_first.p_value) +
+                          " over " + std::string(effect_model_name(first)) + " alone, p " +
+                          scientific(over_second.p_value) + " over " + std::string(effect_model_name(second)) +
+                          " alone (needs < " + scientific(level) + ")");
+      if (c.drop <= 0.0 || 2 * c.paired_poses < static_cast<int>(best_single.poses.size())) continue;
+      if (!over_first.comparable || !over_second.comparable || over_first.p_value >= level ||
+          over_second.p_value >= level) {
+        continue;
+      }
       if (best && c.drop <= best->against_best.drop) continue;
-      CalibrationResult fit = fit_all(robot, samples, options, with);
       if (const std::string why = domain_violation(fit, 2); !why.empty()) {
         report(options, "  reject pair: " + why);
         continue;
       }
-      best = PairChoice{strong[a], strong[b], std::move(f), std::move(fit), c, threshold};
+      best = PairChoice{strong[a], strong[b], std::move(f), std::move(fit), c, over_first, level};
     }
   }
   return best;
 }
 
 }  // namespace
-
-double chi_square_upper_tail(double x, int k) {
-  if (k <= 0) return x > 0.0 ? 0.0 : 1.0;
-  if (x <= 0.0) return 1.0;
-  const double s = 2.0 / (9.0 * k);
-  return normal_upper_tail((std::cbrt(x / k) - (1.0 - s)) / std::sqrt(s));
-}
 
 Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const DiagnosisOptions& options) {
   Diagnosis d;
@@ -213,31 +214,42 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
     const double level = options.alpha / static_cast<double>(untried.size());
     std::vector<CandidateScore> scores;
     std::vector<HeldOutEvaluation> evaluations;
+    std::vector<CalibrationResult> fits;  // on all samples
     for (Effect e : untried) {
-      HeldOutEvaluation f = cross_validate(robot, samples, options, with_effect(model, e));
+      const std::vector<Effect> with = with_effect(model, e);
+      HeldOutEvaluation f = cross_validate(robot, samples, options, with);
+      CalibrationResult fit = f.ok ? fit_all(robot, samples, options, with) : CalibrationResult{};
       CandidateScore score;
       score.effect = e;
-      score.threshold = normal_upper_quantile(level);
+      score.level = level;
+      const FitComparison lr = compare_fits(d.steps.back().fit, fit);
       if (!f.ok) {
         score.failure = f.message;
       } else if (const HeldOutComparison c = compare_held_out(d.steps.back().held_out, f);
                  2 * c.paired_poses < static_cast<int>(d.steps.back().held_out.poses.size())) {
         score.failure = "not comparable: only " + std::to_string(c.paired_poses) +
                         " held-out poses could be evaluated under both models";
+      } else if (!lr.comparable) {
+        score.failure = "not comparable on all samples: " + (fit.ok ? lr.why_not : fit.message);
       } else {
         score.evaluated = true;
         score.held_out_chi2 = f.chi2;
         score.held_out_drop = c.drop;
         score.t_statistic = c.t_statistic;
-        score.significant = score.t_statistic > score.threshold;
+        score.fit_chi2_drop = lr.chi2_drop;
+        score.fit_p_value = lr.p_value;
+        score.significant = score.held_out_drop > 0.0 && score.fit_p_value < level;
       }
       report(options, "  try " + std::string(effect_model_name(e)) + ": " +
-                          (score.evaluated ? "held-out chi2 drop " + fixed(score.held_out_drop, 1) + ", paired t " +
-                                                 fixed(score.t_statistic, 2) + " (needs > " +
-                                                 fixed(score.threshold, 2) + ")"
+                          (score.evaluated ? "held-out chi2 drop " + fixed(score.held_out_drop, 1) + " (paired t " +
+                                                 fixed(score.t_statistic, 2) + "), on all samples " +
+                                                 fixed(score.fit_chi2_drop, 1) + ", p " +
+                                                 scientific(score.fit_p_value) + " (needs a positive held-out " +
+                                                 "drop and p < " + scientific(level) + ")"
                                            : score.failure));
       scores.push_back(score);
       evaluations.push_back(std::move(f));
+      fits.push_back(std::move(fit));
     }
     // Best first: significant before not, then by the held-out drop.
     std::vector<std::size_t> order(scores.size());
@@ -248,14 +260,11 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
     });
     // The best significant candidate whose fit on all samples is physical.
     std::optional<std::size_t> best;
-    CalibrationResult best_fit;
     for (std::size_t j : order) {
       if (!scores[j].significant) break;
-      CalibrationResult fit = fit_all(robot, samples, options, with_effect(model, scores[j].effect));
-      const std::string why = domain_violation(fit, 1);
+      const std::string why = domain_violation(fits[j], 1);
       if (why.empty()) {
         best = j;
-        best_fit = std::move(fit);
         break;
       }
       scores[j].significant = false;
@@ -266,13 +275,13 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
     if (!best) break;
 
     if (options.try_pairs && static_cast<int>(d.steps.size()) + 1 <= options.max_added) {
-      // Still significant: evaluated above its threshold and not rejected as unphysical.
+      // Still significant: passed both tests and not rejected as unphysical.
       std::vector<std::size_t> strong;
       for (std::size_t j : order) {
         if (scores[j].significant) strong.push_back(j);
       }
       if (std::optional<PairChoice> pair =
-              best_pair(robot, samples, options, model, untried, strong, evaluations[*best])) {
+              best_pair(robot, samples, options, model, untried, strong, fits, evaluations[*best])) {
         // Two steps, so that each effect is named with the misfit it removes.
         const Effect first = untried[pair->first], second = untried[pair->second];
         model = with_effect(model, first);
@@ -289,12 +298,11 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
         const HeldOutComparison c = compare_held_out(evaluations[pair->first], pair->held_out);
         then.held_out_drop = c.drop;
         then.t_statistic = c.t_statistic;
-        then.threshold = pair->threshold;
+        then.fit_chi2_drop = pair->over_first.chi2_drop;
+        then.fit_p_value = pair->over_first.p_value;
+        then.level = pair->level;
         then.significant = true;
-        // The best single's fit on all samples is at hand when it leads the pair.
-        CalibrationResult first_fit =
-            pair->first == *best ? std::move(best_fit) : fit_all(robot, samples, options, model);
-        d.steps.push_back({model, first, std::move(first_fit), std::move(evaluations[pair->first]), {then}});
+        d.steps.push_back({model, first, std::move(fits[pair->first]), std::move(evaluations[pair->first]), {then}});
         model = with_effect(model, second);
         d.steps.push_back({model, second, std::move(pair->fit), std::move(pair->held_out), {}});
         continue;
@@ -305,7 +313,7 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
     report(options, "add " + std::string(effect_model_name(scores[*best].effect)) + ": held-out normalized rms " +
                         fixed(d.steps.back().held_out.normalized_rms(), 3) + " -> " +
                         fixed(evaluations[*best].normalized_rms(), 3));
-    d.steps.push_back({model, scores[*best].effect, std::move(best_fit), std::move(evaluations[*best]), {}});
+    d.steps.push_back({model, scores[*best].effect, std::move(fits[*best]), std::move(evaluations[*best]), {}});
   }
 
   const HeldOutEvaluation& last = d.steps.back().held_out;

@@ -12,20 +12,13 @@
 
 #include <gtest/gtest.h>
 
+#include "diagnosis_configs.h"
 #include "sim/dataset.h"
 
 namespace cdpr {
 namespace {
 
-// The large robot of the paper, 45 poses (3-fold cross-validation), nominal
-// anchors 2 m off, the default sensor noise.
-sim::DatasetConfig large_robot(std::uint64_t seed) {
-  sim::DatasetConfig c;
-  c.pose_count = 45;
-  c.seed = seed;
-  c.anchor_perturbation_m = 2.0;
-  return c;
-}
+sim::DatasetConfig large_robot(std::uint64_t seed) { return test::large_robot_45_poses(seed); }
 
 // The small robot of the paper, 90 poses over its whole footprint, nominal
 // anchors 0.5 m off (as tools/diagnose-acceptance.sh "small robot").
@@ -60,7 +53,9 @@ void expect_named_alone_within_three_sigma(const Diagnosis& d, Effect effect, co
 
 TEST(Diagnosis, NamesHiddenElasticityAndRecoversEaWithinThreeSigma) {
   // GIVEN cables with EA = 1.5e6 N that the nominal robot calls inextensible
-  sim::DatasetConfig config = large_robot(2);
+  // (a seed where the paired t of the held-out drops alone was below its
+  // threshold: the likelihood ratio on all samples decides significance)
+  sim::DatasetConfig config = large_robot(11);
   config.effects.axial_stiffness_n = 1.5e6;
   // WHEN the workflow runs
   const Diagnosis d = run(config);
@@ -88,12 +83,12 @@ TEST(Diagnosis, NamesALoadCellBiasAloneWhenTheGainIsRight) {
 }
 
 TEST(Diagnosis, ALoadCellGainReplacesTheBiasAloneInTheModel) {
-  // GIVEN a load cell with a 5 % gain error and a 15 N bias, and a starting
+  // GIVEN a load cell with a 10 % gain error and a 15 N bias, and a starting
   // model that already fits the bias alone
   sim::DatasetConfig config = large_robot(11);
   config.pose_count = 90;
   config.effects.force_bias_n = 15.0;
-  config.effects.force_gain = 0.05;
+  config.effects.force_gain = 0.1;
   auto data = sim::simulate_dataset(config);
   ASSERT_TRUE(data) << data.error();
   DiagnosisOptions options;
@@ -108,7 +103,7 @@ TEST(Diagnosis, ALoadCellGainReplacesTheBiasAloneInTheModel) {
   EXPECT_EQ(d.steps[1].model, std::vector<Effect>{Effect::kLoadCell});
   const EffectValues& fitted = d.steps[1].fit.calibration.effects;
   ASSERT_TRUE(fitted.count("force_gain") && fitted.count("force_gain_sigma"));
-  EXPECT_LT(std::abs(fitted.at("force_gain")[0] - 0.05), 3.0 * fitted.at("force_gain_sigma")[0]);
+  EXPECT_LT(std::abs(fitted.at("force_gain")[0] - 0.1), 3.0 * fitted.at("force_gain_sigma")[0]);
 }
 
 TEST(Diagnosis, FindsElasticityAndLoadCellBiasTogetherThoughADensityErrorMimicsBoth) {
@@ -134,11 +129,30 @@ TEST(Diagnosis, FindsElasticityAndLoadCellBiasTogetherThoughADensityErrorMimicsB
   EXPECT_FALSE(d.structure_remains);
 }
 
+TEST(Diagnosis, FindsALoadCellBiasBesideAnEncoderScale) {
+  // GIVEN encoder scales of 0.3 % and a load cell reading 15 N high, 45
+  // poses: once the scales are fitted, the bias is what remains
+  sim::DatasetConfig config = large_robot(11);
+  config.effects.encoder_scale = {0.003, 0.003, 0.003, 0.003};
+  config.effects.force_bias_n = 15.0;
+  // WHEN the workflow runs
+  const Diagnosis d = run(config);
+  // THEN it adds the scales, then the bias alone, within 3 sigma
+  ASSERT_EQ(d.steps.size(), 3u);
+  EXPECT_EQ(d.steps[1].added, Effect::kEncoderScale);
+  EXPECT_EQ(d.steps[2].added, Effect::kLoadCellBias);
+  const EffectValues& fitted = d.final_fit.calibration.effects;
+  ASSERT_TRUE(fitted.count("force_bias") && fitted.count("force_bias_sigma"));
+  EXPECT_LT(std::abs(fitted.at("force_bias")[0] - 15.0), 3.0 * fitted.at("force_bias_sigma")[0]);
+  EXPECT_FALSE(d.structure_remains);
+}
+
 TEST(Diagnosis, NamesASwivelPulleyOnTheSmallRobotPosedOverItsFootprint) {
-  // GIVEN the small robot with 0.15 m swivel pulleys, 90 poses over its whole
+  // GIVEN the small robot with 0.15 m swivel pulleys, 45 poses over its whole
   // footprint (steep cables seen from many azimuths: the pulley is not just an
   // anchor shift there), nominal anchors 0.5 m off
   sim::DatasetConfig config = small_robot_over_footprint(12);
+  config.pose_count = 45;
   config.effects.pulley_radius_m = 0.15;
   // WHEN the workflow runs
   const Diagnosis d = run(config);

@@ -128,14 +128,16 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
     if (c.truth) append(out, "  mean anchor error against truth: %.4f m\n", mean_anchor_error(step.fit.calibration, *c.truth));
     append_trends(out, step.held_out, 3);
     if (step.candidates.empty()) continue;
-    append(out, "  candidates (held-out chi2 drop; paired t of the per-pose drops, significant above the threshold):\n");
+    append(out, "  candidates (held-out chi2 drop and the paired t of its per-pose drops; chi2 drop of the fit on all "
+                "samples and its likelihood-ratio p; significant: positive held-out drop and p below the level):\n");
     for (const CandidateScore& cand : step.candidates) {
       const std::string name(effect_model_name(cand.effect));
       if (!cand.evaluated) {
         append(out, "    %-14s not evaluated: %s\n", name.c_str(), cand.failure.c_str());
       } else {
-        append(out, "    %-14s %10.1f  t %6.2f (threshold %.2f)%s\n", name.c_str(), cand.held_out_drop, cand.t_statistic,
-               cand.threshold, cand.significant ? "  significant" : "");
+        append(out, "    %-14s %10.1f  t %6.2f  all samples %9.1f  p %8.2g (level %.2g)%s\n", name.c_str(),
+               cand.held_out_drop, cand.t_statistic, cand.fit_chi2_drop, cand.fit_p_value, cand.level,
+               cand.significant ? "  significant" : "");
         if (!cand.failure.empty()) append(out, "      %s\n", cand.failure.c_str());
       }
     }
