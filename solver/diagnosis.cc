@@ -117,7 +117,7 @@ std::string domain_violation(const CalibrationResult& fit, std::size_t count) {
 }
 
 struct PairChoice {
-  std::size_t first = 0, second = 0;  // indices into the round's candidates, first with the larger single drop
+  std::size_t first = 0, second = 0;  // indices into the round's candidates, first the better ranked
   HeldOutEvaluation held_out;
   CalibrationResult fit;
   HeldOutComparison against_best;
@@ -126,7 +126,7 @@ struct PairChoice {
 };
 
 // The pair of the round's individually significant candidates (`strong`,
-// best single drop first, strong[0] the best single; `single_fits` their fits
+// best first, strong[0] the best single; `single_fits` their fits
 // on all samples) without the best single that predicts the held-out poses
 // better than the best single (`best_single`) by the largest drop, if each of its two terms is
 // significant on top of the other (likelihood ratio on all samples at alpha
@@ -238,6 +238,7 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
         score.t_statistic = c.t_statistic;
         score.fit_chi2_drop = lr.chi2_drop;
         score.fit_p_value = lr.p_value;
+        score.added_parameters = lr.added_parameters;
         score.significant = score.held_out_drop > 0.0 && score.fit_p_value < level;
       }
       report(options, "  try " + std::string(effect_model_name(e)) + ": " +
@@ -251,12 +252,15 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
       evaluations.push_back(std::move(f));
       fits.push_back(std::move(fit));
     }
-    // Best first: significant before not, then by the held-out drop.
+    // Best first: significant before not, then by the information criterion
+    // on all samples (less noisy than the held-out drop, whose noise is
+    // twice its signal: ties between a term and its mimic went either way).
     std::vector<std::size_t> order(scores.size());
     for (std::size_t j = 0; j < order.size(); ++j) order[j] = j;
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
       if (scores[a].evaluated != scores[b].evaluated) return scores[a].evaluated;
-      return scores[a].held_out_drop > scores[b].held_out_drop;
+      if (scores[a].significant != scores[b].significant) return scores[a].significant;
+      return scores[a].aic_gain() > scores[b].aic_gain();
     });
     // The best significant candidate whose fit on all samples is physical.
     std::optional<std::size_t> best;

@@ -129,10 +129,15 @@ TEST(Diagnosis, FindsElasticityAndLoadCellBiasTogetherThoughADensityErrorMimicsB
   EXPECT_FALSE(d.structure_remains);
 }
 
-TEST(Diagnosis, FindsALoadCellBiasBesideAnEncoderScale) {
+class EncoderScaleAndBias : public ::testing::TestWithParam<std::uint64_t> {};
+
+TEST_P(EncoderScaleAndBias, FindsTheBiasBesideTheScales) {
   // GIVEN encoder scales of 0.3 % and a load cell reading 15 N high, 45
-  // poses: once the scales are fitted, the bias is what remains
-  sim::DatasetConfig config = large_robot(11);
+  // poses: once the scales are fitted, the bias is what remains. Seed 12: a
+  // density error's held-out drop ties with the bias's, and the information
+  // criterion on all samples tells them apart; seed 13: the largest held-out
+  // drop (a pulley) is not significant, and the significant bias comes next.
+  sim::DatasetConfig config = large_robot(GetParam());
   config.effects.encoder_scale = {0.003, 0.003, 0.003, 0.003};
   config.effects.force_bias_n = 15.0;
   // WHEN the workflow runs
@@ -146,6 +151,8 @@ TEST(Diagnosis, FindsALoadCellBiasBesideAnEncoderScale) {
   EXPECT_LT(std::abs(fitted.at("force_bias")[0] - 15.0), 3.0 * fitted.at("force_bias_sigma")[0]);
   EXPECT_FALSE(d.structure_remains);
 }
+
+INSTANTIATE_TEST_SUITE_P(Diagnosis, EncoderScaleAndBias, ::testing::Values(11u, 12u, 13u));
 
 TEST(Diagnosis, NamesASwivelPulleyOnTheSmallRobotPosedOverItsFootprint) {
   // GIVEN the small robot with 0.15 m swivel pulleys, 45 poses over its whole
