@@ -28,6 +28,14 @@ std::vector<Effect> with_effect(const std::vector<Effect>& model, Effect e) {
   return with;
 }
 
+// The effect of the model that e replaces when added, if any.
+std::optional<Effect> replaced_by(const std::vector<Effect>& model, Effect e) {
+  for (Effect m : model) {
+    if (effect_contains(e, m)) return m;
+  }
+  return std::nullopt;
+}
+
 // Whether adding e to the model would add anything: not when the model has it
 // or an effect that contains it.
 bool can_add(const std::vector<Effect>& model, Effect e) {
@@ -203,7 +211,7 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
   }
   report(options, "fit " + model_text(model) + ": held-out chi2 " + fixed(start.chi2, 1) + ", expected " +
                       fixed(start.expected_chi2, 1) + ", normalized rms " + fixed(start.normalized_rms(), 3));
-  d.steps.push_back({model, Effect::kElasticity, std::move(start_fit), std::move(start), {}});
+  d.steps.push_back({model, Effect::kElasticity, std::move(start_fit), std::move(start), {}, std::nullopt});
 
   while (static_cast<int>(d.steps.size()) - 1 < options.max_added) {
     std::vector<Effect> untried;
@@ -288,6 +296,7 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
               best_pair(robot, samples, options, model, untried, strong, fits, evaluations[*best])) {
         // Two steps, so that each effect is named with the misfit it removes.
         const Effect first = untried[pair->first], second = untried[pair->second];
+        const std::optional<Effect> first_replaced = replaced_by(model, first);
         model = with_effect(model, first);
         report(options, "add pair " + std::string(effect_model_name(first)) + " + " +
                             std::string(effect_model_name(second)) + ": held-out normalized rms " +
@@ -306,18 +315,41 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
         then.fit_p_value = pair->over_first.p_value;
         then.level = pair->level;
         then.significant = true;
-        d.steps.push_back({model, first, std::move(fits[pair->first]), std::move(evaluations[pair->first]), {then}});
+        d.steps.push_back(
+            {model, first, std::move(fits[pair->first]), std::move(evaluations[pair->first]), {then}, first_replaced});
+        const std::optional<Effect> second_replaced = replaced_by(model, second);
         model = with_effect(model, second);
-        d.steps.push_back({model, second, std::move(pair->fit), std::move(pair->held_out), {}});
+        d.steps.push_back({model, second, std::move(pair->fit), std::move(pair->held_out), {}, second_replaced});
         continue;
       }
     }
 
+    const std::optional<Effect> replaced = replaced_by(model, scores[*best].effect);
     model = with_effect(model, scores[*best].effect);
     report(options, "add " + std::string(effect_model_name(scores[*best].effect)) + ": held-out normalized rms " +
                         fixed(d.steps.back().held_out.normalized_rms(), 3) + " -> " +
                         fixed(evaluations[*best].normalized_rms(), 3));
-    d.steps.push_back({model, scores[*best].effect, std::move(fits[*best]), std::move(evaluations[*best]), {}});
+    d.steps.push_back(
+        {model, scores[*best].effect, std::move(fits[*best]), std::move(evaluations[*best]), {}, replaced});
+  }
+
+  // Back to the narrower form of a term whose extra parameters are not
+  // significant with everything else in the model.
+  for (Effect narrow : kAllEffects) {
+    const auto wide = std::find_if(model.begin(), model.end(), [narrow](Effect m) { return effect_contains(m, narrow); });
+    if (wide == model.end()) continue;
+    const Effect was = *wide;
+    std::vector<Effect> narrowed = model;
+    narrowed[static_cast<std::size_t>(wide - model.begin())] = narrow;
+    CalibrationResult fit = fit_all(robot, samples, options, narrowed);
+    const FitComparison lr = compare_fits(fit, d.steps.back().fit);
+    if (!lr.comparable || lr.p_value < options.alpha) continue;
+    HeldOutEvaluation f = cross_validate(robot, samples, options, narrowed);
+    if (!f.ok) continue;
+    report(options, "narrow " + std::string(effect_model_name(was)) + " to " + std::string(effect_model_name(narrow)) +
+                        ": its extra parameters are not significant (p " + scientific(lr.p_value) + ")");
+    model = narrowed;
+    d.steps.push_back({model, narrow, std::move(fit), std::move(f), {}, was});
   }
 
   const HeldOutEvaluation& last = d.steps.back().held_out;

@@ -22,10 +22,15 @@
 // single steps can be led astray when one effect mimics two others together,
 // so a round with a significant candidate also tries pairs of them
 // (DiagnosisOptions::try_pairs). A candidate that contains an effect of the
-// model (load_cell contains load_cell_bias) replaces it when added.
+// model (load_cell contains load_cell_bias) replaces it when added. When no
+// candidate is left significant, a wider term whose extra parameters are not
+// significant (alpha, likelihood ratio on all samples) with everything else
+// in the model goes back to its narrower form: a load-cell gain taken while
+// an elasticity was still missing is often no gain at all once it is there.
 // Pure numerics: progress goes through a callback.
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -77,6 +82,7 @@ struct DiagnosisStep {
   CalibrationResult fit;       // on all samples: the values reported for this model
   HeldOutEvaluation held_out;  // pooled over the folds, each fold predicted by a fit without it
   std::vector<CandidateScore> candidates;  // tried from this step, best first
+  std::optional<Effect> replaced;  // the effect `added` took the place of (load_cell <-> load_cell_bias)
 };
 
 struct Diagnosis {

@@ -74,20 +74,31 @@ void append_trends(std::string& out, const HeldOutEvaluation& h, int count) {
   }
 }
 
+// The effects of the final model that the starting model did not have.
+std::vector<Effect> added_effects(const Diagnosis& d) {
+  std::vector<Effect> out;
+  for (Effect e : d.steps.back().model) {
+    if (std::find(d.steps.front().model.begin(), d.steps.front().model.end(), e) == d.steps.front().model.end()) {
+      out.push_back(e);
+    }
+  }
+  return out;
+}
+
 // One machine-readable line for scripts (tools/diagnose-acceptance.sh).
 void append_summary(std::string& out, const Diagnosis& d, const ReportContext& c) {
+  // The terms of the final model beyond the starting one (a term replaced on the way is not named).
+  const std::vector<Effect> named = added_effects(d);
   std::string added;
-  for (std::size_t s = 1; s < d.steps.size(); ++s) {
-    added += (added.empty() ? "" : ",") + std::string(effect_model_name(d.steps[s].added));
-  }
+  for (Effect e : named) added += (added.empty() ? "" : ",") + std::string(effect_model_name(e));
   append(out, "summary: added=%s structure=%s normalized_rms_start=%.4f normalized_rms_final=%.4f",
          added.empty() ? "none" : added.c_str(), d.structure_remains ? "remains" : "none",
          d.steps.front().held_out.normalized_rms(), d.steps.back().held_out.normalized_rms());
   if (c.truth && d.final_fit.ok) {
     // Of the final fit on all samples: anchors, and the largest |fitted - true| / sigma over the added effects.
     double worst = 0.0;
-    for (std::size_t s = 1; s < d.steps.size(); ++s) {
-      for (const std::string& name : effect_value_names(d.steps[s].added)) {
+    for (Effect e : named) {
+      for (const std::string& name : effect_value_names(e)) {
         worst = std::max(worst, sigma_distance(d.final_fit.calibration.effects, c.truth->effects, name));
       }
     }
@@ -114,7 +125,8 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
     const DiagnosisStep& step = d.steps[s];
     append(out, "\nstep %zu: %s\n", s, model_text(step.model).c_str());
     if (s > 0) {
-      append(out, "  added %s:\n", std::string(effect_model_name(step.added)).c_str());
+      append(out, "  added %s%s:\n", std::string(effect_model_name(step.added)).c_str(),
+             step.replaced ? (" in place of " + std::string(effect_model_name(*step.replaced))).c_str() : "");
       for (const std::string& name : effect_value_names(step.added)) {
         append(out, "    %s = %s\n", name.c_str(), values_text(step.fit.calibration.effects, name).c_str());
         if (!c.truth) continue;
@@ -151,7 +163,9 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
   } else {
     append(out, "added");
     for (std::size_t s = 1; s < d.steps.size(); ++s) {
-      append(out, " %s", std::string(effect_model_name(d.steps[s].added)).c_str());
+      append(out, " %s%s", std::string(effect_model_name(d.steps[s].added)).c_str(),
+             d.steps[s].replaced ? (" (in place of " + std::string(effect_model_name(*d.steps[s].replaced)) + ")").c_str()
+                                 : "");
     }
     append(out, "; held-out normalized rms %.3f -> %.3f, encoder rms %.4f -> %.4f m, force rms %.2f -> %.2f N\n",
            first.held_out.normalized_rms(), last.held_out.normalized_rms(), first.held_out.rms_encoder_m,
