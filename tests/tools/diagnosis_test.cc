@@ -82,6 +82,25 @@ TEST(Diagnosis, NamesALoadCellBiasAloneWhenTheGainIsRight) {
   EXPECT_EQ(d.final_fit.calibration.model, (std::vector<std::string>{"catenary", "load_cell_bias"}));
 }
 
+TEST(Diagnosis, KeepsTheLoadCellBiasWhereTwoMimicsTogetherPredictNoBetter) {
+  // GIVEN a load cell reading 15 N high, 90 poses, where an encoder scale plus
+  // a density error predict the held-out poses a little better than the
+  // load-cell term (a chi2 drop of 5 over 90 poses: noise)
+  sim::DatasetConfig config = large_robot(11);
+  config.pose_count = 90;
+  config.effects.force_bias_n = 15.0;
+  // WHEN the workflow runs
+  const Diagnosis d = run(config);
+  // THEN the pair of mimics does not replace the load-cell term, which ends
+  // as the bias alone within 3 sigma
+  ASSERT_FALSE(d.steps.empty());
+  EXPECT_EQ(d.steps.back().model, std::vector<Effect>{Effect::kLoadCellBias});
+  ASSERT_TRUE(d.final_fit.ok);
+  const EffectValues& fitted = d.final_fit.calibration.effects;
+  ASSERT_TRUE(fitted.count("force_bias") && fitted.count("force_bias_sigma"));
+  EXPECT_LT(std::abs(fitted.at("force_bias")[0] - 15.0), 3.0 * fitted.at("force_bias_sigma")[0]);
+}
+
 TEST(Diagnosis, ALoadCellGainReplacesTheBiasAloneInTheModel) {
   // GIVEN a load cell with a 10 % gain error and a 15 N bias, and a starting
   // model that already fits the bias alone
