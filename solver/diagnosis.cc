@@ -348,6 +348,42 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
         {model, scores[*best].effect, std::move(fits[*best]), std::move(evaluations[*best]), {}, replaced});
   }
 
+  // Backward: drop the added term least needed with everything else in the
+  // model while the likelihood ratio for keeping it is not significant at
+  // alpha. A mimic taken first (a density error for an elasticity and a
+  // load-cell bias) stays beside the true terms the later rounds add.
+  while (true) {
+    std::optional<std::size_t> weakest;
+    CalibrationResult weakest_fit;
+    double weakest_p = options.alpha;
+    for (std::size_t j = 0; j < model.size(); ++j) {
+      if (std::find(options.fit.effects.begin(), options.fit.effects.end(), model[j]) != options.fit.effects.end()) {
+        continue;  // the starting model stays
+      }
+      std::vector<Effect> without = model;
+      without.erase(without.begin() + static_cast<std::ptrdiff_t>(j));
+      CalibrationResult fit = fit_all(robot, samples, options, without);
+      const FitComparison lr = compare_fits(fit, d.steps.back().fit);
+      if (lr.comparable && lr.p_value >= weakest_p) {
+        weakest = j;
+        weakest_p = lr.p_value;
+        weakest_fit = std::move(fit);
+      }
+    }
+    if (!weakest) break;
+    std::vector<Effect> without = model;
+    without.erase(without.begin() + static_cast<std::ptrdiff_t>(*weakest));
+    HeldOutEvaluation f = cross_validate(robot, samples, options, without);
+    if (!f.ok) break;
+    const Effect dropped = model[*weakest];
+    report(options, "remove " + std::string(effect_model_name(dropped)) +
+                        ": not significant with the rest of the model (p " + scientific(weakest_p) + ")");
+    model = without;
+    DiagnosisStep step{model, dropped, std::move(weakest_fit), std::move(f), {}, std::nullopt};
+    step.removed = true;
+    d.steps.push_back(std::move(step));
+  }
+
   // Back to the narrower form of a term whose extra parameters are not
   // significant with everything else in the model.
   for (Effect narrow : kAllEffects) {

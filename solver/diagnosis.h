@@ -23,7 +23,9 @@
 // so a round with a significant candidate also tries pairs of them
 // (DiagnosisOptions::try_pairs). A candidate that contains an effect of the
 // model (load_cell contains load_cell_bias) replaces it when added. When no
-// candidate is left significant, a wider term whose extra parameters are not
+// candidate is left significant, an added term that is not significant
+// (alpha, likelihood ratio on all samples) with the rest of the model is
+// removed, the least needed first, and a wider term whose extra parameters are not
 // significant (alpha, likelihood ratio on all samples) with everything else
 // in the model goes back to its narrower form: a load-cell gain taken while
 // an elasticity was still missing is often no gain at all once it is there.
@@ -78,11 +80,13 @@ struct CandidateScore {
 
 struct DiagnosisStep {
   std::vector<Effect> model;  // effects in the model at this step
-  Effect added = Effect::kElasticity;  // the effect this step added (not for step 0)
+  Effect added = Effect::kElasticity;  // the effect this step added (not for step 0), or removed
+
   CalibrationResult fit;       // on all samples: the values reported for this model
   HeldOutEvaluation held_out;  // pooled over the folds, each fold predicted by a fit without it
   std::vector<CandidateScore> candidates;  // tried from this step, best first
   std::optional<Effect> replaced;  // the effect `added` took the place of (load_cell <-> load_cell_bias)
+  bool removed = false;            // this step removed `added` from the model
 };
 
 struct Diagnosis {

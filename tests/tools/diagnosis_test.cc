@@ -82,6 +82,26 @@ TEST(Diagnosis, NamesALoadCellBiasAloneWhenTheGainIsRight) {
   EXPECT_EQ(d.final_fit.calibration.model, (std::vector<std::string>{"catenary", "load_cell_bias"}));
 }
 
+TEST(Diagnosis, RemovesAMimicTakenFirstOnceTheTrueTermsAreIn) {
+  // GIVEN cables with EA = 1.5e6 N and a load cell reading 15 N high, 45
+  // poses, where a density error alone predicts best in the first round
+  sim::DatasetConfig config = large_robot(13);
+  config.effects.axial_stiffness_n = 1.5e6;
+  config.effects.force_bias_n = 15.0;
+  // WHEN the workflow runs
+  const Diagnosis d = run(config);
+  // THEN the density error, added first, is removed once the elasticity and
+  // the bias are in the model, and those two remain
+  ASSERT_GE(d.steps.size(), 2u);
+  EXPECT_EQ(d.steps[1].added, Effect::kDensityError);
+  EXPECT_TRUE(d.steps.back().removed);
+  EXPECT_EQ(d.steps.back().added, Effect::kDensityError);
+  std::vector<Effect> model = d.steps.back().model;
+  std::sort(model.begin(), model.end());
+  EXPECT_EQ(model, (std::vector<Effect>{Effect::kElasticity, Effect::kLoadCellBias}));
+  EXPECT_FALSE(d.structure_remains);
+}
+
 TEST(Diagnosis, KeepsTheLoadCellBiasWhereTwoMimicsTogetherPredictNoBetter) {
   // GIVEN a load cell reading 15 N high, 90 poses, where an encoder scale plus
   // a density error predict the held-out poses a little better than the

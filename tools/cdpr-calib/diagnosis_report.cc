@@ -124,7 +124,10 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
   for (std::size_t s = 0; s < d.steps.size(); ++s) {
     const DiagnosisStep& step = d.steps[s];
     append(out, "\nstep %zu: %s\n", s, model_text(step.model).c_str());
-    if (s > 0) {
+    if (s > 0 && step.removed) {
+      append(out, "  removed %s: not significant with the rest of the model\n",
+             std::string(effect_model_name(step.added)).c_str());
+    } else if (s > 0) {
       append(out, "  added %s%s:\n", std::string(effect_model_name(step.added)).c_str(),
              step.replaced ? (" in place of " + std::string(effect_model_name(*step.replaced))).c_str() : "");
       for (const std::string& name : effect_value_names(step.added)) {
@@ -163,7 +166,7 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
   } else {
     append(out, "added");
     for (std::size_t s = 1; s < d.steps.size(); ++s) {
-      append(out, " %s%s", std::string(effect_model_name(d.steps[s].added)).c_str(),
+      append(out, " %s%s%s", d.steps[s].removed ? "removed:" : "", std::string(effect_model_name(d.steps[s].added)).c_str(),
              d.steps[s].replaced ? (" (in place of " + std::string(effect_model_name(*d.steps[s].replaced)) + ")").c_str()
                                  : "");
     }
