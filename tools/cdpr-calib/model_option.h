@@ -1,6 +1,6 @@
 #pragma once
 // The --model option of cdpr-calib: a cable model (catenary or rigid) and
-// optional model terms (solver/effects.h), e.g. "catenary,elasticity,force_bias".
+// optional model terms (solver/effects.h), e.g. "catenary,elasticity,load_cell_bias".
 
 #include <optional>
 #include <string>
