@@ -1,35 +1,37 @@
 #pragma once
-// The model-discrepancy workflow (DESIGN.md "Model terms"): by k-fold
-// cross-validation, fit the current model without one fold of the samples
-// and measure how well it predicts that fold's poses, pooled over the folds;
-// try each candidate effect (solver/effects.h) and add the one whose held-out
-// chi-square drops the most, if that drop is significant; repeat until no
-// candidate is; then say whether the held-out misfit is still above the noise.
+// The model-discrepancy workflow (DESIGN.md "Model terms"): find where the
+// model and the measurements disagree, name the missing effect (solver/
+// effects.h), add it, and show the gap shrink on poses the fit never saw.
 //
-// Evidence is held-out and in-sample together. Held-out chi2 is a predictive
-// log-likelihood (a term that only fits training noise makes it worse, not
-// better): a candidate must make its drop, chi2(current) - chi2(with
-// candidate) over the poses both models evaluate (solver/
-// held_out_comparison.h), positive. Its significance is the likelihood-ratio
-// test of the two fits on all samples (solver/fit_comparison.h) at level
-// alpha / m (Bonferroni over the m candidates of the round). The significant
-// candidates are ranked by Akaike's criterion on all samples: the held-out
-// drop, twice as noisy, let a mimic with a tied drop win over the true term. A test of the held-out drops alone (the paired t
-// of the per-pose drops, still reported) has about half the z of the
-// likelihood ratio, since each drop's noise is twice the signal's: it left
-// 4-7 sigma effects unnamed at 45 poses. A significant candidate whose fit on all samples leaves its physical range
-// (solver/effects.h effect_domain_violation) is rejected, not added. Greedy
-// single steps can be led astray when one effect mimics two others together,
-// so a round with a significant candidate also tries pairs of them
-// (DiagnosisOptions::try_pairs). A candidate that contains an effect of the
-// model (load_cell contains load_cell_bias) replaces it when added. When no
-// candidate is left significant, an added term that is not significant
-// (alpha, likelihood ratio on all samples) with the rest of the model is
-// removed, the least needed first, and a wider term whose extra parameters are not
-// significant (alpha, likelihood ratio on all samples) with everything else
-// in the model goes back to its narrower form: a load-cell gain taken while
-// an elasticity was still missing is often no gain at all once it is there.
-// Pure numerics: progress goes through a callback.
+// Held-out misfit: by k-fold cross-validation, each fold's poses are
+// predicted by a fit without them (solver/held_out.h), pooled over folds.
+// Its chi-square is a predictive log-likelihood: a term that only fits
+// training noise makes it worse, not better.
+//
+// Forward steps (solver/model_search.h): every effect not yet in the model
+// is tried. It is significant when its held-out chi2 drops, over the poses
+// both models evaluate (solver/held_out_comparison.h), and the likelihood
+// ratio of the two fits on all samples (solver/fit_comparison.h) is below
+// alpha / m (Bonferroni over the m candidates of the round). The paired t of
+// the per-pose held-out drops is reported, not tested: each drop's noise is
+// twice its signal, so it has about half the likelihood ratio's z and left
+// 4-7 sigma effects unnamed at 45 poses. Significant candidates are ranked
+// by Akaike's criterion on all samples (the held-out drop let a mimic with a
+// tied drop win over the true term); one whose fit leaves its physical range
+// (effect_domain_violation) is rejected: it mimics something else. A round
+// with significant candidates also tries pairs of them (solver/
+// pair_search.h), as one effect can mimic two others together. Adding a
+// wider effect replaces the narrower one it contains (load_cell replaces
+// load_cell_bias).
+//
+// Backward steps, once nothing more is significant: an added term not
+// significant (alpha, likelihood ratio on all samples) with the rest of the
+// model is removed, the least needed first; a wider term whose extra
+// parameters are not significant goes back to its narrower form.
+//
+// Finally it says whether the held-out misfit is still above the noise:
+// structure that no known effect explains. Pure numerics: progress goes
+// through a callback.
 
 #include <functional>
 #include <optional>

@@ -91,8 +91,8 @@ void append_summary(std::string& out, const Diagnosis& d, const ReportContext& c
   const std::vector<Effect> named = added_effects(d);
   std::string added;
   for (Effect e : named) added += (added.empty() ? "" : ",") + std::string(effect_model_name(e));
-  append(out, "summary: added=%s structure=%s normalized_rms_start=%.4f normalized_rms_final=%.4f",
-         added.empty() ? "none" : added.c_str(), d.structure_remains ? "remains" : "none",
+  append(out, "summary: added=%s structure=%s structure_p=%.2g normalized_rms_start=%.4f normalized_rms_final=%.4f",
+         added.empty() ? "none" : added.c_str(), d.structure_remains ? "remains" : "none", d.structure_p_value,
          d.steps.front().held_out.normalized_rms(), d.steps.back().held_out.normalized_rms());
   if (c.truth && d.final_fit.ok) {
     // Of the final fit on all samples: anchors, and the largest |fitted - true| / sigma over the added effects.

@@ -1,0 +1,48 @@
+#pragma once
+// The pair step of the model-discrepancy workflow (solver/diagnosis.h). Two
+// effects can each be mimicked in part by a third (a cable elasticity and a
+// load-cell bias together look much like a cable density error); then the
+// greedy single step takes the mimic and neither true effect is significant
+// on top of it. So a round with significant candidates also tries pairs of
+// them.
+
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include "solver/diagnosis.h"
+#include "solver/fit_comparison.h"
+#include "solver/held_out_comparison.h"
+
+namespace cdpr {
+
+// A pair chosen over the best single candidate of a round.
+struct PairChoice {
+  std::size_t first = 0, second = 0;  // indices into the round's candidates, first the better ranked
+  HeldOutEvaluation held_out;
+  CalibrationResult fit;
+  HeldOutComparison against_best;
+  FitComparison over_first;  // the second term on top of the first, on all samples
+  double level = 0.0;
+};
+
+// Among pairs of the round's individually significant candidates (`strong`:
+// indices into `candidates`, best first, strong[0] the best single;
+// `single_fits`: every candidate's fit on all samples), the one that predicts
+// the held-out poses better than the best single (`best_single`, its
+// cross-validation) by the largest drop, where
+//   - neither term is a form of the best single: a pair with it is the
+//     greedy next step, which tries every candidate, not the strong ones only;
+//   - the drop's paired t is significant (alpha over the pairs): the models
+//     are not nested, and a positive drop alone, which noise gives half the
+//     time, would let a pair replace a well-supported single;
+//   - each term is significant on top of the other (likelihood ratio on all
+//     samples at alpha over the pairs);
+//   - both fitted values are physical.
+std::optional<PairChoice> best_pair(const Robot& robot, const std::vector<Sample>& samples,
+                                    const DiagnosisOptions& options, const std::vector<Effect>& model,
+                                    const std::vector<Effect>& candidates, const std::vector<std::size_t>& strong,
+                                    const std::vector<CalibrationResult>& single_fits,
+                                    const HeldOutEvaluation& best_single);
+
+}  // namespace cdpr
