@@ -35,4 +35,13 @@ double chi_square_upper_tail(double x, int k) {
   return std::erfc(std::sqrt(h)) + sum;
 }
 
+double scaled_chi_square_upper_tail(double x, double mean, double variance) {
+  if (mean <= 0.0) return x > 0.0 ? 0.0 : 1.0;
+  if (x <= 0.0) return 1.0;
+  if (variance <= 0.0) variance = 2.0 * mean;
+  const double nu = 2.0 * mean * mean / variance;  // x / a / nu = x / mean
+  const double s = 2.0 / (9.0 * nu);
+  return normal_upper_tail((std::cbrt(x / mean) - (1.0 - s)) / std::sqrt(s));
+}
+
 }  // namespace cdpr

@@ -10,5 +10,10 @@ double normal_upper_tail(double z);
 // likelihood-ratio test, where Wilson-Hilferty is off by tens of percent in
 // the far tail), Wilson-Hilferty above.
 double chi_square_upper_tail(double x, int k);
+// P(X > x) for X ~ a chi-square(nu) whose mean a nu and variance 2 a^2 nu
+// are `mean` and `variance` (Satterthwaite's match for a sum of squares
+// whose terms are not independent); Wilson-Hilferty, nu need not be whole.
+// A variance <= 0 is taken as 2 mean, a plain chi-square(mean).
+double scaled_chi_square_upper_tail(double x, double mean, double variance);
 
 }  // namespace cdpr

@@ -262,9 +262,15 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
   narrow_wide_effects(d, robot, samples, options);
 
   const HeldOutEvaluation& last = d.steps.back().held_out;
-  // The excess over the expected chi2 as a chi-square(dof) scaled to that mean.
-  d.structure_p_value = chi_square_upper_tail(last.chi2 * last.dof / last.expected_chi2, last.dof);
-  d.structure_remains = last.normalized_rms() > options.structure_ratio && d.structure_p_value < options.alpha;
+  // A significant excess over what a right model gives is structure,
+  // whatever its size: an effect the known terms mimic in part (a 117 N
+  // wind: CoM, load-cell and encoder-scale terms) leaves a small one, 1.19
+  // times the noise in rms at p 4e-5, which a threshold of 1.2 on the rms
+  // called "no structure". The test needs chi2's true spread under a right
+  // model (HeldOutEvaluation::chi2_variance): taken as a chi-square's, it
+  // gave p < 0.01 in 2 of 10 data sets without effects.
+  d.structure_p_value = scaled_chi_square_upper_tail(last.chi2, last.expected_chi2, last.chi2_variance);
+  d.structure_remains = d.structure_p_value < options.alpha;
   report(options, d.structure_remains ? "structure remains that no known effect explains"
                                       : "no structure left above the noise");
 

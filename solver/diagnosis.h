@@ -56,10 +56,6 @@ struct DiagnosisOptions {
   // second term is significant on top of it (at alpha over the number of
   // pairs).
   bool try_pairs = true;
-  // The held-out misfit counts as unexplained structure when its normalized
-  // rms (HeldOutEvaluation) exceeds this and chi2 is significant at `alpha`
-  // against its expected value.
-  double structure_ratio = 1.2;
   std::function<void(const std::string&)> progress;  // one line per fit; may be empty
 };
 
@@ -98,7 +94,10 @@ struct Diagnosis {
   int folds = 0;
   std::vector<DiagnosisStep> steps;  // steps[0] is the starting model
   bool structure_remains = false;
-  double structure_p_value = 1.0;    // of the final held-out chi2 against its dof
+  // Of the final held-out chi2 against its expected value; structure remains
+  // when it is below alpha, however small the excess (its size is the final
+  // step's normalized rms).
+  double structure_p_value = 1.0;
   CalibrationResult final_fit;       // the final model on all samples (== steps.back().fit)
 };
 

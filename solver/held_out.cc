@@ -38,13 +38,13 @@ std::vector<int> global_columns(const EffectPoseFactor& factor, const Calibratio
   return columns;
 }
 
-// tr(H Sigma) of one held-out pose: its residuals' Jacobian J = [J_l J_g]
-// over its own variables l (pose 6, reference force 2) and the globals g,
-// H = J_g^T J_g - J_g^T J_l (J_l^T J_l)^-1 J_l^T J_g (l eliminated).
-// Zero when the pose cannot be evaluated.
-double predictive_inflation(const EffectPoseFactor& factor, const PosePriorFactor& prior,
+// Adds one held-out pose's information on the globals to `h`: its
+// residuals' Jacobian J = [J_l J_g] over its own variables l (pose 6,
+// reference force 2) and the globals g, J_g^T J_g - J_g^T J_l (J_l^T J_l)^-1
+// J_l^T J_g (l eliminated). Adds nothing when the pose cannot be evaluated.
+void add_held_out_information(const EffectPoseFactor& factor, const PosePriorFactor& prior,
                             const std::vector<const double*>& blocks, const CalibrationResult& trained,
-                            const std::vector<int>& global_column) {
+                            const std::vector<int>& global_column, Eigen::MatrixXd& h) {
   const int p = static_cast<int>(trained.global_covariance.rows());
   constexpr int kLocal = 8, kRows = EffectPoseFactor::kResidualDim + 6;
   Eigen::MatrixXd j_local = Eigen::MatrixXd::Zero(kRows, kLocal), j_global = Eigen::MatrixXd::Zero(kRows, p);
@@ -59,7 +59,7 @@ double predictive_inflation(const EffectPoseFactor& factor, const PosePriorFacto
   }
   std::array<double, EffectPoseFactor::kResidualDim> residual;
   double cost = 0.0;
-  if (!factor.evaluate(blocks.data(), residual.data(), jacobians.data(), &cost)) return 0.0;
+  if (!factor.evaluate(blocks.data(), residual.data(), jacobians.data(), &cost)) return;
   for (std::size_t b = 0; b < keys.size(); ++b) {
     for (int r = 0; r < EffectPoseFactor::kResidualDim; ++r) {
       for (int c = 0; c < dims[b]; ++c) {
@@ -73,14 +73,12 @@ double predictive_inflation(const EffectPoseFactor& factor, const PosePriorFacto
   std::array<double, 36> prior_jacobian{};
   double* prior_blocks[1] = {prior_jacobian.data()};
   std::array<double, 6> prior_residual;
-  if (!prior.evaluate(blocks.data(), prior_residual.data(), prior_blocks, &cost)) return 0.0;
+  if (!prior.evaluate(blocks.data(), prior_residual.data(), prior_blocks, &cost)) return;
   for (int r = 0; r < 6; ++r) {
     for (int c = 0; c < 6; ++c) j_local(EffectPoseFactor::kResidualDim + r, c) = prior_jacobian[r * 6 + c];
   }
   const Eigen::MatrixXd lg = j_local.transpose() * j_global;
-  const Eigen::MatrixXd h = j_global.transpose() * j_global -
-                            lg.transpose() * (j_local.transpose() * j_local).ldlt().solve(lg);
-  return h.cwiseProduct(trained.global_covariance).sum();
+  h += j_global.transpose() * j_global - lg.transpose() * (j_local.transpose() * j_local).ldlt().solve(lg);
 }
 
 }  // namespace
@@ -124,7 +122,9 @@ HeldOutEvaluation evaluate_held_out(const Robot& robot, const std::vector<Sample
     return out;
   }
 
-  double sum_encoder = 0.0, sum_height = 0.0, sum_force = 0.0, inflation = 0.0;
+  double sum_encoder = 0.0, sum_height = 0.0, sum_force = 0.0;
+  const Eigen::MatrixXd& sigma = trained.global_covariance;
+  Eigen::MatrixXd information = Eigen::MatrixXd::Zero(sigma.rows(), sigma.cols());
   int residual_count = 0;
   for (std::size_t k = 0; k < built.samples.size(); ++k) {
     const int pose_index = static_cast<int>(k);
@@ -149,7 +149,7 @@ HeldOutEvaluation evaluate_held_out(const Robot& robot, const std::vector<Sample
     }
     sum_force += std::pow(pose.prediction.force_residual_n, 2);
     residual_count += EffectPoseFactor::kResidualDim + 6;  // + the pose prior
-    inflation += predictive_inflation(factor, prior, blocks, trained, global_columns(factor, trained));
+    add_held_out_information(factor, prior, blocks, trained, global_columns(factor, trained), information);
     out.poses.push_back(pose);
   }
   if (out.poses.empty()) {
@@ -164,7 +164,14 @@ HeldOutEvaluation evaluate_held_out(const Robot& robot, const std::vector<Sample
   // each pose has 8 unknowns of its own (pose 6, reference force 2).
   out.chi2 = 2.0 * summary.final_cost;
   out.dof = residual_count - 8 * static_cast<int>(out.poses.size());
+  // The training fit's error d ~ N(0, Sigma) is shared by every pose of
+  // this fold: chi2 = |e|^2 + 2 e'J_g d + d'H d over the held-out noise e,
+  // so its mean is dof + tr(H Sigma) and its variance 2 dof + 4 tr(H Sigma)
+  // + 2 tr((H Sigma)^2), more than a chi-square of that mean has.
+  const Eigen::MatrixXd h_sigma = information * sigma;
+  const double inflation = h_sigma.trace();
   out.expected_chi2 = out.dof + inflation;
+  out.chi2_variance = 2.0 * out.dof + 4.0 * inflation + 2.0 * h_sigma.cwiseProduct(h_sigma.transpose()).sum();
   out.ok = true;
   return out;
 }

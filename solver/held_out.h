@@ -37,6 +37,10 @@ struct HeldOutEvaluation {
   // (H: the held-out poses' information on the global parameters with their
   // own variables eliminated; Sigma: the training covariance).
   double expected_chi2 = 0.0;
+  // chi2's variance if the model were right: the training fit's error is
+  // shared by all the poses of a fold, so it is more than 2 expected_chi2.
+  // Folds are pooled as if independent.
+  double chi2_variance = 0.0;
   // sqrt(chi2 / expected_chi2): 1 at the noise floor.
   double normalized_rms() const;
 };

@@ -19,6 +19,7 @@ void pool(HeldOutEvaluation& total, HeldOutEvaluation&& part) {
   total.rms_force_n = mean_square(total.rms_force_n, part.rms_force_n);
   total.chi2 += part.chi2;
   total.expected_chi2 += part.expected_chi2;
+  total.chi2_variance += part.chi2_variance;
   total.dof += part.dof;
   total.rejected_samples.insert(total.rejected_samples.end(), part.rejected_samples.begin(), part.rejected_samples.end());
   for (HeldOutPose& pose : part.poses) total.poses.push_back(std::move(pose));

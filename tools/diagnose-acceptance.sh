@@ -76,7 +76,7 @@ run_case() {
     base_sum=$(awk -v s="$base_sum" -v a="${base:-0}" 'BEGIN { print s + a }')
     anchor_sum=$(awk -v s="$anchor_sum" -v a="$anchor" 'BEGIN { print s + a }')
     echo "  $name seed $seed: added $added, nrms $nrms0 -> $nrms1, anchor error $base -> $anchor m," \
-         "effect $sd sigma, ${line##*structure=}" | cut -c1-160 >&2
+         "effect $sd sigma, structure $(field structure "$line") (p $(field structure_p "$line"))" >&2
   done
   printf "| %-34s | %-26s | %5s | %9s | %8s | %9s | %9s | %15s | %9s |\n" "$name" "$expected" \
     "$named/$runs" "$within/$fitted" "$floor/$runs" \

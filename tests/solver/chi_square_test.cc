@@ -33,5 +33,18 @@ TEST(ChiSquareUpperTail, IsOneAtZeroAndFallsWithX) {
   EXPECT_GT(chi_square_upper_tail(4.0, 5), chi_square_upper_tail(6.0, 5));
 }
 
+TEST(ScaledChiSquareUpperTail, IsAChiSquareWhenTheVarianceIsTwiceTheMean) {
+  // chi-square(100): mean 100, variance 200
+  EXPECT_NEAR(scaled_chi_square_upper_tail(124.342, 100.0, 200.0), 0.05, 0.001);
+  EXPECT_NEAR(scaled_chi_square_upper_tail(124.342, 100.0, 0.0), 0.05, 0.001);
+}
+
+TEST(ScaledChiSquareUpperTail, MatchesAScaledChiSquareOfTheSameMeanAndVariance) {
+  // 2 chi-square(50): mean 100, variance 400; chi-square(50) exceeds 67.505 with p 0.05
+  EXPECT_NEAR(scaled_chi_square_upper_tail(2.0 * 67.505, 100.0, 400.0), 0.05, 0.002);
+  // a wider spread makes the same excess less significant
+  EXPECT_GT(scaled_chi_square_upper_tail(130.0, 100.0, 400.0), scaled_chi_square_upper_tail(130.0, 100.0, 200.0));
+}
+
 }  // namespace
 }  // namespace cdpr
