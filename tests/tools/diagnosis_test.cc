@@ -40,15 +40,20 @@ Diagnosis run(const sim::DatasetConfig& config) {
   return d;
 }
 
+// The fit's [effects] value `name` (its first component) is within 3 sigma of `truth`.
+void expect_within_three_sigma(const CalibrationResult& fit, const std::string& name, double truth) {
+  ASSERT_TRUE(fit.ok);
+  const EffectValues& fitted = fit.calibration.effects;
+  ASSERT_TRUE(fitted.count(name) && fitted.count(name + "_sigma")) << name;
+  EXPECT_LT(std::abs(fitted.at(name)[0] - truth), 3.0 * fitted.at(name + "_sigma")[0]) << name;
+}
+
 // The workflow added `effect` alone, and the final fit's [effects] value
 // `name` is within 3 sigma of `truth`.
 void expect_named_alone_within_three_sigma(const Diagnosis& d, Effect effect, const std::string& name, double truth) {
   ASSERT_EQ(d.steps.size(), 2u) << "expected exactly one effect added";
   EXPECT_EQ(d.steps[1].added, effect);
-  ASSERT_TRUE(d.final_fit.ok);
-  const EffectValues& fitted = d.final_fit.calibration.effects;
-  ASSERT_TRUE(fitted.count(name) && fitted.count(name + "_sigma")) << name;
-  EXPECT_LT(std::abs(fitted.at(name)[0] - truth), 3.0 * fitted.at(name + "_sigma")[0]) << name;
+  expect_within_three_sigma(d.final_fit, name, truth);
 }
 
 TEST(Diagnosis, NamesHiddenElasticityAndRecoversEaWithinThreeSigma) {
@@ -115,10 +120,7 @@ TEST(Diagnosis, KeepsTheLoadCellBiasWhereTwoMimicsTogetherPredictNoBetter) {
   // as the bias alone within 3 sigma
   ASSERT_FALSE(d.steps.empty());
   EXPECT_EQ(d.steps.back().model, std::vector<Effect>{Effect::kLoadCellBias});
-  ASSERT_TRUE(d.final_fit.ok);
-  const EffectValues& fitted = d.final_fit.calibration.effects;
-  ASSERT_TRUE(fitted.count("force_bias") && fitted.count("force_bias_sigma"));
-  EXPECT_LT(std::abs(fitted.at("force_bias")[0] - 15.0), 3.0 * fitted.at("force_bias_sigma")[0]);
+  expect_within_three_sigma(d.final_fit, "force_bias", 15.0);
 }
 
 TEST(Diagnosis, ALoadCellGainReplacesTheBiasAloneInTheModel) {
@@ -140,9 +142,7 @@ TEST(Diagnosis, ALoadCellGainReplacesTheBiasAloneInTheModel) {
   ASSERT_GE(d.steps.size(), 2u);
   EXPECT_EQ(d.steps[1].added, Effect::kLoadCell);
   EXPECT_EQ(d.steps[1].model, std::vector<Effect>{Effect::kLoadCell});
-  const EffectValues& fitted = d.steps[1].fit.calibration.effects;
-  ASSERT_TRUE(fitted.count("force_gain") && fitted.count("force_gain_sigma"));
-  EXPECT_LT(std::abs(fitted.at("force_gain")[0] - 0.1), 3.0 * fitted.at("force_gain_sigma")[0]);
+  expect_within_three_sigma(d.steps[1].fit, "force_gain", 0.1);
 }
 
 TEST(Diagnosis, FindsElasticityAndLoadCellBiasTogetherThoughADensityErrorMimicsBoth) {
@@ -166,10 +166,8 @@ TEST(Diagnosis, FindsElasticityAndLoadCellBiasTogetherThoughADensityErrorMimicsB
   ASSERT_EQ(d.steps.size(), 4u);
   EXPECT_EQ(d.steps[3].added, Effect::kLoadCellBias);
   EXPECT_EQ(d.steps[3].replaced, Effect::kLoadCell);
-  const EffectValues& fitted = d.final_fit.calibration.effects;
-  ASSERT_TRUE(fitted.count("axial_stiffness") && fitted.count("force_bias"));
-  EXPECT_LT(std::abs(fitted.at("axial_stiffness")[0] - 1.5e6), 3.0 * fitted.at("axial_stiffness_sigma")[0]);
-  EXPECT_LT(std::abs(fitted.at("force_bias")[0] - 15.0), 3.0 * fitted.at("force_bias_sigma")[0]);
+  expect_within_three_sigma(d.final_fit, "axial_stiffness", 1.5e6);
+  expect_within_three_sigma(d.final_fit, "force_bias", 15.0);
   EXPECT_FALSE(d.structure_remains);
 }
 
@@ -190,9 +188,7 @@ TEST_P(EncoderScaleAndBias, FindsTheBiasBesideTheScales) {
   ASSERT_EQ(d.steps.size(), 3u);
   EXPECT_EQ(d.steps[1].added, Effect::kEncoderScale);
   EXPECT_EQ(d.steps[2].added, Effect::kLoadCellBias);
-  const EffectValues& fitted = d.final_fit.calibration.effects;
-  ASSERT_TRUE(fitted.count("force_bias") && fitted.count("force_bias_sigma"));
-  EXPECT_LT(std::abs(fitted.at("force_bias")[0] - 15.0), 3.0 * fitted.at("force_bias_sigma")[0]);
+  expect_within_three_sigma(d.final_fit, "force_bias", 15.0);
   EXPECT_FALSE(d.structure_remains);
 }
 
