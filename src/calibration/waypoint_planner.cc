@@ -4,6 +4,7 @@
 #include <limits>
 #include <random>
 
+#include "solver/pose_design.h"
 #include "src/calibration/message_text.h"
 
 namespace cdpr::calibration {
@@ -102,6 +103,14 @@ std::vector<int> farthest_points(const std::vector<Waypoint>& candidates, const 
   return chosen;
 }
 
+// A-optimal selection on the robot's nominal geometry.
+std::vector<int> informative_points(const Robot& robot, const std::vector<Waypoint>& candidates, int count) {
+  std::vector<Pose> poses;
+  poses.reserve(candidates.size());
+  for (const Waypoint& w : candidates) poses.push_back(w.rest.world_T_platform);
+  return choose_informative_poses(robot, poses, count);
+}
+
 // Greedy nearest-neighbour tour from `start`: short moves between poses.
 std::vector<Waypoint> travel_order(std::vector<Waypoint> waypoints, const Eigen::Vector3d& start) {
   std::vector<Waypoint> ordered;
@@ -163,7 +172,9 @@ WaypointPlan plan_waypoints(const Robot& robot, const std::array<double, kCableC
     return plan;
   }
   std::vector<Waypoint> chosen;
-  for (const int k : farthest_points(feasible, 0.5 * (box.low + box.high), options.waypoint_count)) {
+  for (const int k : options.selection == WaypointSelection::kInformative
+                         ? informative_points(robot, feasible, options.waypoint_count)
+                         : farthest_points(feasible, 0.5 * (box.low + box.high), options.waypoint_count)) {
     chosen.push_back(feasible[k]);
   }
   plan.waypoints = travel_order(std::move(chosen), start_world);

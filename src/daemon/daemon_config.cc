@@ -209,7 +209,7 @@ void read_calibration(TomlReader& reader, ConfigReader& r, const toml::table& ro
                                    {"z_max", kOptional}, {"grid_xy", kOptional}, {"grid_z", kOptional},
                                    {"jitter", kOptional}, {"seed", kOptional}, {"min_tension", kOptional},
                                    {"max_tension", kOptional}, {"min_payout", kOptional}, {"max_payout", kOptional},
-                                   {"max_sag_excess", kOptional}});
+                                   {"max_sag_excess", kOptional}, {"selection", kOptional}});
   r.integer(waypoints, "count", p, w.waypoint_count, 1, 10'000);
   r.number(waypoints, "margin", p, w.margin_m, Bound::kNonNegative);
   r.number(waypoints, "z_min", p, w.z_min_m, Bound::kAny);
@@ -226,6 +226,9 @@ void read_calibration(TomlReader& reader, ConfigReader& r, const toml::table& ro
   r.number(waypoints, "max_payout", p, w.max_payout_m, Bound::kAny);
   r.number(waypoints, "max_sag_excess", p, w.max_sag_excess, Bound::kPositive);
   if (w.jitter_fraction >= 0.5) r.fail(waypoints, "jitter", p, "must be in [0, 0.5)");
+  if (const int selection = r.choice(waypoints, "selection", p, {"spread", "informative"}); selection >= 0) {
+    w.selection = selection == 0 ? calibration::WaypointSelection::kSpread : calibration::WaypointSelection::kInformative;
+  }
 
   const toml::table& eq = reader.table(root, "equilibrium", "", kOptional);
   p = "equilibrium";

@@ -7,6 +7,7 @@
 
 #include "../../solver/test_robots.h"
 #include "solver/cable_prediction.h"
+#include "solver/pose_design.h"
 
 namespace cdpr::calibration {
 namespace {
@@ -47,6 +48,32 @@ TEST(StaticPose, RestPoseBalancesTheWeightAndReachesEveryAttachment) {
   }
   EXPECT_NEAR(lift_n, robot.platform_mass_kg * robot.gravity_mps2, 1e-6 * lift_n);
   EXPECT_EQ(rest->world_T_platform.position_world, position);
+}
+
+TEST(WaypointPlanner, InformativeSelectionDeterminesAnchorsAndOffsetsBetterThanSpread) {
+  // GIVEN the large robot, its workspace and limits
+  const Robot robot = test::large_robot();
+  PlannerOptions spread = large_options(), informative = large_options();
+  informative.selection = WaypointSelection::kInformative;
+  // WHEN 35 waypoints are picked from the same candidates both ways
+  const WaypointPlan a = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), spread);
+  const WaypointPlan b = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), informative);
+  ASSERT_TRUE(a.ok()) << a.problem;
+  ASSERT_TRUE(b.ok()) << b.problem;
+  ASSERT_EQ(b.waypoints.size(), 35u);
+  // THEN the informative ones bound the summed variance of anchors and
+  // offsets lower (measured: 0.047 -> 0.040 m anchor sigma norm), all distinct
+  const auto poses = [](const WaypointPlan& plan) {
+    std::vector<Pose> out;
+    for (const Waypoint& w : plan.waypoints) out.push_back(w.rest.world_T_platform);
+    return out;
+  };
+  EXPECT_LT(design_variance_sum(robot, poses(b)), 0.8 * design_variance_sum(robot, poses(a)));
+  for (std::size_t j = 0; j < b.waypoints.size(); ++j) {
+    for (std::size_t k = j + 1; k < b.waypoints.size(); ++k) {
+      EXPECT_NE(b.waypoints[j].rest.world_T_platform.position_world, b.waypoints[k].rest.world_T_platform.position_world);
+    }
+  }
 }
 
 TEST(WaypointPlanner, PlansWellSpreadWaypointsInsideTheLimits) {

@@ -42,6 +42,7 @@ TEST(DaemonConfig, TheShippedExampleParsesToTheDefaults) {
   EXPECT_EQ(p.margin_m, defaults.calibrator.planner.margin_m);
   EXPECT_EQ(p.z_max_m, defaults.calibrator.planner.z_max_m);
   EXPECT_EQ(p.max_tension_n, defaults.calibrator.planner.max_tension_n);
+  EXPECT_EQ(p.selection, defaults.calibrator.planner.selection);
   EXPECT_EQ(config->calibrator.settle_timeout_us, defaults.calibrator.settle_timeout_us);
   EXPECT_EQ(config->calibrator.first_contact_timeout_us, defaults.calibrator.first_contact_timeout_us);
   EXPECT_EQ(config->calibrator.enable_timeout_us, defaults.calibrator.enable_timeout_us);
@@ -67,6 +68,8 @@ word_order = "low_word_first"
 kind = "none"
 [equilibrium]
 window_s = 1.5
+[waypoints]
+selection = "informative"
 [limits]
 first_contact_timeout_s = 0.5
 [validation]
@@ -83,6 +86,7 @@ accept_max_iterations = true
   EXPECT_TRUE(config->load_cell.low_word_first);
   EXPECT_FALSE(config->button.gpio);
   EXPECT_EQ(config->calibrator.equilibrium.window_us, 1'500'000);
+  EXPECT_EQ(config->calibrator.planner.selection, calibration::WaypointSelection::kInformative);
   EXPECT_EQ(config->calibrator.first_contact_timeout_us, 500'000);
   EXPECT_TRUE(config->calibrator.validation.accept_max_iterations);
 }
@@ -97,6 +101,7 @@ TEST(DaemonConfig, RefusesBadInputNamingLineAndKey) {
       {"robot = \"r\"\n[loop]\nperiod_msec = 10\n", 3, "loop.period_msec"},               // unknown key
       {"robot = \"r\"\n[load_cell]\nslave_id = 300\n", 3, "load_cell.slave_id"},          // out of range
       {"robot = \"r\"\n[button]\nkind = \"gpoi\"\n", 3, "button.kind"},                    // not a choice
+      {"robot = \"r\"\n[waypoints]\nselection = \"optimal\"\n", 3, "waypoints.selection"},  // not a choice
       {"robot = \"r\"\n[loop]\nperiod_ms = -5\n", 3, "loop.period_ms"},                    // not positive
       {"robot = \"r\"\n[button]\nactive_low = 1\n", 3, "button.active_low"},               // not a bool
       {"[store]\nstate_dir = \"/x\"\n", 0, "robot"},                                        // missing required
