@@ -85,12 +85,22 @@ std::optional<ReferenceForceMap> force_map(const Robot& robot, const std::array<
   return map;
 }
 
-// Damped Gauss-Newton on the fit's residuals over N unknowns x: Levenberg's
-// damping of the normal matrix's diagonal, ten times more after a failed
-// trial, ten times less after a success; at most 50 trials. `evaluate(x,
-// residual, jacobian)` is false outside the model; `propose(x, H, g)` gives
-// the trial point from the damped normal matrix H and gradient g. False
-// when the start x cannot be evaluated; else x is the best point found.
+// Levenberg-Marquardt on the fit's residuals over N unknowns x, with the
+// damping of the solver's own loop (Nielsen's update, as Ceres'
+// LevenbergMarquardtStrategy): a step is taken when the cost falls by more
+// than 1e-3 of what the model predicts; the damping of the normal matrix's
+// diagonal then shrinks smoothly with the gain ratio rho, and after a
+// refused trial it grows by nu = 2, 4, 8, ... (a fixed factor of ten up and
+// down made the trials alternate between two dampings, one overshooting
+// and one creeping, up to the trial cap). It stops when a step gains less
+// than 1e-12 of the cost, and, without evaluating, once the model predicts
+// no more than that: near the minimum rounding would refuse trial after
+// trial. At most 50 trials.
+//
+// `evaluate(x, residual, jacobian)` is false outside the model;
+// `propose(x, H, g)` gives the trial point from the damped normal matrix H
+// and gradient g. False when the start x cannot be evaluated; else x is the
+// best point found.
 template <int N, typename Evaluate, typename Propose>
 bool damped_gauss_newton(Eigen::Matrix<double, N, 1>& x, const Evaluate& evaluate, const Propose& propose) {
   using Vector = Eigen::Matrix<double, N, 1>;
@@ -99,23 +109,33 @@ bool damped_gauss_newton(Eigen::Matrix<double, N, 1>& x, const Evaluate& evaluat
   Jacobian jacobian, trial_jacobian;
   if (!evaluate(x, residual, jacobian)) return false;
   double cost = residual.squaredNorm();
-  double damping = 1e-3;
+  double damping = 1e-3, nu = 2.0;
   for (int iteration = 0; iteration < 50 && damping < 1e12; ++iteration) {
     const Vector gradient = jacobian.transpose() * residual;
-    Eigen::Matrix<double, N, N> H = jacobian.transpose() * jacobian;
+    const Eigen::Matrix<double, N, N> jtj = jacobian.transpose() * jacobian;
+    Eigen::Matrix<double, N, N> H = jtj;
     H.diagonal() *= 1.0 + damping;
     const Vector trial = propose(x, H, gradient);
-    if (evaluate(trial, trial_residual, trial_jacobian) && trial_residual.squaredNorm() < cost) {
-      const double trial_cost = trial_residual.squaredNorm();
+    const Vector step = trial - x;
+    // The cost is |r|^2: the undamped model's decrease is -(2 g's + s'J'Js).
+    const double predicted = -(2.0 * gradient.dot(step) + step.dot(jtj * step));
+    if (!(predicted > 1e-12 * (1.0 + cost))) break;
+    const bool evaluable = evaluate(trial, trial_residual, trial_jacobian);
+    const double trial_cost = evaluable ? trial_residual.squaredNorm() : cost;
+    const double rho = (cost - trial_cost) / predicted;
+    if (evaluable && trial_cost < cost && rho > 1e-3) {
       const bool converged = cost - trial_cost < 1e-12 * (1.0 + cost);
       x = trial;
       residual = trial_residual;
       jacobian = trial_jacobian;
       cost = trial_cost;
-      damping = std::max(damping / 10.0, 1e-9);
+      const double t = 2.0 * rho - 1.0;
+      damping = std::max(damping * std::max(1.0 / 3.0, 1.0 - t * t * t), 1e-9);
+      nu = 2.0;
       if (converged) break;
     } else {
-      damping *= 10.0;
+      damping *= nu;
+      nu *= 2.0;
     }
   }
   return true;
@@ -212,14 +232,16 @@ std::optional<ForceAndHeading> refine_reference_force_and_heading(
   auto propose = [&](const Eigen::Vector3d& current, const Eigen::Matrix3d& H, const Eigen::Vector3d& gradient) {
     Eigen::Vector3d step = -H.ldlt().solve(gradient);
     const double yaw = current(2);
-    // At a bound the cost wants to cross, the heading stays there and the
-    // step is taken in the forces alone (a projected Gauss-Newton step).
-    if ((yaw <= yaw_min_rad && step(2) < 0.0) || (yaw >= yaw_max_rad && step(2) > 0.0)) {
-      step.head<2>() = -H.topLeftCorner<2, 2>().ldlt().solve(gradient.head<2>());
-      step(2) = 0.0;
+    // A step that would cross a bound stops the heading on it, and the forces
+    // take the model's best step for that turn: the minimum of the quadratic
+    // model with the heading fixed (clamping the heading alone kept forces
+    // fitted to a far larger turn).
+    const double bounded = std::clamp(yaw + step(2), yaw_min_rad, yaw_max_rad);
+    if (bounded != yaw + step(2)) {
+      step(2) = bounded - yaw;
+      step.head<2>() = -H.topLeftCorner<2, 2>().ldlt().solve(gradient.head<2>() + H.block<2, 1>(0, 2) * step(2));
     }
-    return Eigen::Vector3d(current(0) + step(0), current(1) + step(1),
-                           std::clamp(yaw + step(2), yaw_min_rad, yaw_max_rad));
+    return Eigen::Vector3d(current(0) + step(0), current(1) + step(1), bounded);
   };
   if (!damped_gauss_newton<3>(x, evaluate_at, propose)) return std::nullopt;
   return ForceAndHeading{x.head<2>(), x(2)};
