@@ -33,6 +33,9 @@ struct CableStatics {
   double span = 0.0;          // [m] L_i, horizontal anchor-attachment distance
   double anchor_z = 0.0;      // [m]
   double attachment_z = 0.0;  // [m] world height of the attachment point
+  // Rows over the statics parameters. The geometry's are zero outside the
+  // pose's columns and (span, anchor_z) this cable's own anchor's, whatever
+  // the forces (StaticPoseFactor sums only the rows that reach a block).
   StaticsRow d_f_h, d_f_v, d_span, d_anchor_z, d_attachment_z;
 };
 

@@ -12,20 +12,56 @@ namespace {
 // Tangent sizes of the variables, in keys() order.
 constexpr std::array<int, StaticPoseFactor::kKeyCount> kBlockDims = {6, 2, 3, 3, 3, 3, 1, 1, 1, 1};
 
-using ResidualRow = Eigen::Matrix<double, 1, kStaticsParamDim>;
+// One residual row's derivative as the chain rule through a cable's catenary
+// inputs: sum_k weight[k] * (d f_h, d f_v, d span, d anchor_z,
+// d attachment_z)[k], each a statics row.
+struct ChainWeights {
+  double f_h = 0.0, f_v = 0.0, span = 0.0, anchor_z = 0.0, attachment_z = 0.0;
+};
 
-// Copies the statics-parameter columns of one residual row into the factor's
-// Jacobian blocks (pose, reference force, anchors); offsets are set separately.
-void scatter_row(const ResidualRow& row, int r, double* const* jacobians) {
-  constexpr int kDim = StaticPoseFactor::kResidualDim;
+// Row r of the factor's Jacobian blocks (pose, reference force, anchors;
+// zero in the offsets) for cable `cable`, straight from its statics rows.
+// Only the forces depend on everything; the geometry does not: the span
+// and anchor height depend on the pose and the cable's own anchor, the
+// attachment height on the pose alone, none of them on the reference
+// force. So each block sums only the rows that reach it, instead of five
+// 23-wide rows scaled, added and copied (nearly a third of the factor's
+// instructions went there).
+void write_chain_row(const CableStatics& c, int cable, const ChainWeights& w, int r, double* const* jacobians) {
   static_assert(kStaticsPose == 0 && kStaticsForce == 6 && kStaticsAnchor == 8);
-  if (jacobians[0]) for (int c = 0; c < 6; ++c) jacobians[0][r * 6 + c] = row(kStaticsPose + c);
-  if (jacobians[1]) for (int c = 0; c < 2; ++c) jacobians[1][r * 2 + c] = row(kStaticsForce + c);
+  if (double* pose = jacobians[0]) {
+    for (int k = 0; k < 6; ++k) {
+      pose[r * 6 + k] = w.f_h * c.d_f_h(k) + w.f_v * c.d_f_v(k) + w.span * c.d_span(k) +
+                        w.anchor_z * c.d_anchor_z(k) + w.attachment_z * c.d_attachment_z(k);
+    }
+  }
+  if (double* force = jacobians[1]) {
+    for (int k = 0; k < 2; ++k) {
+      force[r * 2 + k] = w.f_h * c.d_f_h(kStaticsForce + k) + w.f_v * c.d_f_v(kStaticsForce + k);
+    }
+  }
   for (int i = 0; i < kCableCount; ++i) {
-    if (jacobians[2 + i]) for (int c = 0; c < 3; ++c) jacobians[2 + i][r * 3 + c] = row(kStaticsAnchor + 3 * i + c);
+    if (double* anchor = jacobians[2 + i]) {
+      const int first = kStaticsAnchor + 3 * i;
+      for (int k = 0; k < 3; ++k) anchor[r * 3 + k] = w.f_h * c.d_f_h(first + k) + w.f_v * c.d_f_v(first + k);
+      if (i == cable) {
+        for (int k = 0; k < 3; ++k) {
+          anchor[r * 3 + k] += w.span * c.d_span(first + k) + w.anchor_z * c.d_anchor_z(first + k);
+        }
+      }
+    }
     if (jacobians[2 + kCableCount + i]) jacobians[2 + kCableCount + i][r] = 0.0;
   }
-  (void)kDim;
+}
+
+// The force row (Eq. 16) depends on the reference force alone.
+void write_force_row(const Eigen::Vector2d& d_force, int r, double* const* jacobians) {
+  if (jacobians[0]) for (int c = 0; c < 6; ++c) jacobians[0][r * 6 + c] = 0.0;
+  if (jacobians[1]) for (int c = 0; c < 2; ++c) jacobians[1][r * 2 + c] = d_force(c);
+  for (int i = 0; i < kCableCount; ++i) {
+    if (jacobians[2 + i]) for (int c = 0; c < 3; ++c) jacobians[2 + i][r * 3 + c] = 0.0;
+    if (jacobians[2 + kCableCount + i]) jacobians[2 + kCableCount + i][r] = 0.0;
+  }
 }
 
 }  // namespace
@@ -69,13 +105,15 @@ bool StaticPoseFactor::evaluate(const double* const* parameters, double* residua
     residual[kCableCount + i] = (c.attachment_z - shape.end_height) / sigma_height_m_;         // Eq. (15)
     if (!with_jacobian) continue;
 
-    // Chain rule through (f_h, f_v, span, anchor_z) of the catenary.
-    const ResidualRow d_length = shape.d_arc_length(0) * c.d_f_h + shape.d_arc_length(1) * c.d_f_v +
-                                 shape.d_arc_length(2) * c.d_span + shape.d_arc_length(3) * c.d_anchor_z;
-    const ResidualRow d_height = shape.d_end_height(0) * c.d_f_h + shape.d_end_height(1) * c.d_f_v +
-                                 shape.d_end_height(2) * c.d_span + shape.d_end_height(3) * c.d_anchor_z;
-    scatter_row(d_length / sigma_encoder, i, jacobians);
-    scatter_row((c.d_attachment_z - d_height) / sigma_height_m_, kCableCount + i, jacobians);
+    // Chain rule through (f_h, f_v, span, anchor_z) of the catenary, whitened.
+    const Eigen::Matrix<double, 1, 4>& dl = shape.d_arc_length;
+    const Eigen::Matrix<double, 1, 4>& dz = shape.d_end_height;
+    const double to_encoder = 1.0 / sigma_encoder, to_height = 1.0 / sigma_height_m_;
+    write_chain_row(c, i, {dl(0) * to_encoder, dl(1) * to_encoder, dl(2) * to_encoder, dl(3) * to_encoder, 0.0}, i,
+                    jacobians);
+    write_chain_row(c, i,
+                    {-dz(0) * to_height, -dz(1) * to_height, -dz(2) * to_height, -dz(3) * to_height, to_height},
+                    kCableCount + i, jacobians);
     if (jacobians[2 + kCableCount + i]) jacobians[2 + kCableCount + i][i] = 1.0 / sigma_encoder;
   }
 
@@ -85,12 +123,9 @@ bool StaticPoseFactor::evaluate(const double* const* parameters, double* residua
   const double sigma_force = robot_.noise.force_n;
   residual[force_row] = (tension - force_n_) / sigma_force;
   if (with_jacobian) {
-    ResidualRow row = ResidualRow::Zero();
-    if (tension > 0.0) {
-      row(kStaticsForce) = in.reference_force.x() / (tension * sigma_force);
-      row(kStaticsForce + 1) = in.reference_force.y() / (tension * sigma_force);
-    }
-    scatter_row(row, force_row, jacobians);
+    const Eigen::Vector2d d_force =
+        tension > 0.0 ? Eigen::Vector2d(in.reference_force / (tension * sigma_force)) : Eigen::Vector2d::Zero();
+    write_force_row(d_force, force_row, jacobians);
   }
   *cost = apply_loss(loss_, kResidualDim, residual, jacobians, kBlockDims);
   return true;
