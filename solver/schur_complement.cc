@@ -559,34 +559,23 @@ void SchurComplement::solve(const double* b, double* x) {
   }
 }
 
-double SchurComplement::quadratic(const double* x) const {
-  const int n = global_dim_;
-  const double* x_global = x + local_dim_;
+double SchurComplement::damping_quadratic(const double* x, double radius, double min_diagonal,
+                                          double max_diagonal) const {
   double sum = 0.0;
   for (const Group& g : groups_) {
-    const int d = g.dim, m = g.coupled_end - g.coupled_begin;
     const double* a = a_.data() + g.block;
-    const double* b = b_.data() + g.coupling;
-    const int* columns = coupled_.data() + g.coupled_begin;
     const double* xl = x + g.column;
-    for (int j = 0; j < d; ++j) {
-      double off = 0.0;
-      for (int i = 0; i < j; ++i) off += a[i + d * j] * xl[i];
-      sum += xl[j] * (2.0 * off + a[j + d * j] * xl[j]);
-    }
-    for (int i = 0; i < d; ++i) {
-      double dot = 0.0;
-      for (int p = 0; p < m; ++p) dot += b[i * m + p] * x_global[columns[p]];
-      sum += 2.0 * dot * xl[i];
+    for (int j = 0; j < g.dim; ++j) {
+      sum += std::clamp(a[j + g.dim * j], min_diagonal, max_diagonal) * xl[j] * xl[j];
     }
   }
+  const int n = global_dim_;
+  const double* x_global = x + local_dim_;
   for (int j = 0; j < n; ++j) {
-    const double* c = c_.data() + static_cast<std::size_t>(n) * j;
-    double off = 0.0;
-    for (int i = 0; i < j; ++i) off += c[i] * x_global[i];
-    sum += x_global[j] * (2.0 * off + c[j] * x_global[j]);
+    const double diagonal = c_[j + static_cast<std::size_t>(n) * j];
+    sum += std::clamp(diagonal, min_diagonal, max_diagonal) * x_global[j] * x_global[j];
   }
-  return sum;
+  return sum / radius;
 }
 
 }  // namespace cdpr

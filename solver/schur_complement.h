@@ -54,8 +54,9 @@ class SchurComplement {
   FactorizationStatus factorize(double radius, double min_diagonal, double max_diagonal, std::string* message);
   // x = (J^T J + D / radius)^-1 b with the last successful factorisation; x may alias b.
   void solve(const double* b, double* x);
-  // x' J^T J x.
-  double quadratic(const double* x) const;
+  // x' D x / radius, the damping factorize(radius, ...) added: what the LM
+  // loop needs for the model decrease of a step.
+  double damping_quadratic(const double* x, double radius, double min_diagonal, double max_diagonal) const;
 
   // out(r, c) += sum_i Ja(i, r) Jb(i, c) for row-major m x da and m x db blocks.
   using BlockKernel = void (*)(int m, int da, int db, const double* ja, const double* jb, double* out, int stride);
