@@ -1,6 +1,8 @@
 #include "solver/fit_comparison.h"
 
 #include <algorithm>
+#include <limits>
+#include <vector>
 
 #include "solver/chi_square.h"
 #include "solver/effect_pose_factor.h"
@@ -15,6 +17,14 @@ int global_parameter_count(const CalibrationResult& fit) {
   return count;
 }
 
+// Whether both fits kept the same samples (their chi2 sum the same data).
+bool same_samples(const CalibrationResult& a, const CalibrationResult& b) {
+  std::vector<int> rejected_a = a.rejected_samples, rejected_b = b.rejected_samples;
+  std::sort(rejected_a.begin(), rejected_a.end());
+  std::sort(rejected_b.begin(), rejected_b.end());
+  return rejected_a == rejected_b;
+}
+
 }  // namespace
 
 FitComparison compare_fits(const CalibrationResult& smaller, const CalibrationResult& larger) {
@@ -23,10 +33,7 @@ FitComparison compare_fits(const CalibrationResult& smaller, const CalibrationRe
     out.why_not = "a fit on all samples failed";
     return out;
   }
-  std::vector<int> rejected_smaller = smaller.rejected_samples, rejected_larger = larger.rejected_samples;
-  std::sort(rejected_smaller.begin(), rejected_smaller.end());
-  std::sort(rejected_larger.begin(), rejected_larger.end());
-  if (rejected_smaller != rejected_larger) {
+  if (!same_samples(smaller, larger)) {
     out.why_not = "the two fits kept different samples";
     return out;
   }
@@ -46,6 +53,12 @@ FitComparison compare_fits(const CalibrationResult& smaller, const CalibrationRe
   out.p_value = chi_square_upper_tail(out.chi2_drop / out.scale, out.added_parameters);
   out.comparable = true;
   return out;
+}
+
+double akaike_gain(const CalibrationResult& from, const CalibrationResult& to) {
+  if (!from.ok || !to.ok || !same_samples(from, to)) return -std::numeric_limits<double>::infinity();
+  return 2.0 * (from.solver.final_cost - to.solver.final_cost) -
+         2.0 * (global_parameter_count(to) - global_parameter_count(from));
 }
 
 }  // namespace cdpr

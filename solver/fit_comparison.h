@@ -27,4 +27,12 @@ struct FitComparison {
 // comparable when they kept the same samples and `larger` has more parameters.
 FitComparison compare_fits(const CalibrationResult& smaller, const CalibrationResult& larger);
 
+// Akaike's criterion from `from` to `to`, two ok fits of any models on the
+// same samples: the drop in chi2, 2 (cost_from - cost_to), less 2 per
+// parameter `to` has beyond `from` (negative when it has fewer). Positive:
+// `to` is the better model by the expected Kullback-Leibler distance to the
+// truth; it needs no nesting, so it compares a pair of terms with a third.
+// Minus infinity when a fit failed or they kept different samples.
+double akaike_gain(const CalibrationResult& from, const CalibrationResult& to);
+
 }  // namespace cdpr

@@ -36,14 +36,15 @@ std::optional<PairChoice> best_pair(const Robot& robot, const std::vector<Sample
     CalibrationResult fit = fit_all(robot, samples, options, with);
     const FitComparison over_first = compare_fits(single_fits[strong[a]], fit);
     const FitComparison over_second = compare_fits(single_fits[strong[b]], fit);
+    const double aic_gain = akaike_gain(single_fits[strong.front()], fit);
     report(options, "  try pair " + std::string(effect_model_name(first)) + " + " +
-                        std::string(effect_model_name(second)) + ": held-out chi2 drop " + fixed(c.drop, 1) +
-                        " against the best single; on all samples p " + scientific(over_first.p_value) +
-                        " over " + std::string(effect_model_name(first)) + " alone, p " +
-                        scientific(over_second.p_value) + " over " + std::string(effect_model_name(second)) +
-                        " alone; held-out paired t " + fixed(c.t_statistic, 2) + ", p " +
-                        scientific(normal_upper_tail(c.t_statistic)) + " (each needs < " + scientific(level) + ")");
-    if (normal_upper_tail(c.t_statistic) >= level || 2 * c.paired_poses < static_cast<int>(best_single.poses.size())) {
+                        std::string(effect_model_name(second)) + ": against the best single, held-out chi2 drop " +
+                        fixed(c.drop, 1) + " (paired t " + fixed(c.t_statistic, 2) + "), Akaike gain on all samples " +
+                        fixed(aic_gain, 1) + "; on all samples p " + scientific(over_first.p_value) + " over " +
+                        std::string(effect_model_name(first)) + " alone, p " + scientific(over_second.p_value) +
+                        " over " + std::string(effect_model_name(second)) +
+                        " alone (needs a positive drop and gain, each p < " + scientific(level) + ")");
+    if (c.drop <= 0.0 || aic_gain <= 0.0 || 2 * c.paired_poses < static_cast<int>(best_single.poses.size())) {
       continue;
     }
     if (!over_first.comparable || !over_second.comparable || over_first.p_value >= level ||

@@ -89,18 +89,20 @@ TEST(Diagnosis, NamesALoadCellBiasAloneWhenTheGainIsRight) {
 
 TEST(Diagnosis, RemovesAMimicTakenFirstOnceTheTrueTermsAreIn) {
   // GIVEN cables with EA = 1.5e6 N and a load cell reading 15 N high, 45
-  // poses, where a density error alone predicts best in the first round
-  sim::DatasetConfig config = large_robot(13);
+  // poses, where an elasticity paired with encoder scales predicts best in
+  // the first round
+  sim::DatasetConfig config = large_robot(12);
   config.effects.axial_stiffness_n = 1.5e6;
   config.effects.force_bias_n = 15.0;
   // WHEN the workflow runs
   const Diagnosis d = run(config);
-  // THEN the density error, added first, is removed once the elasticity and
-  // the bias are in the model, and those two remain
-  ASSERT_GE(d.steps.size(), 2u);
-  EXPECT_EQ(d.steps[1].added, Effect::kDensityError);
+  // THEN the encoder scales, added first, are removed once the bias is in
+  // the model too, and the elasticity and the bias remain
+  ASSERT_GE(d.steps.size(), 3u);
+  EXPECT_EQ(d.steps[2].added, Effect::kEncoderScale);
+  EXPECT_FALSE(d.steps[2].removed);
   EXPECT_TRUE(d.steps.back().removed);
-  EXPECT_EQ(d.steps.back().added, Effect::kDensityError);
+  EXPECT_EQ(d.steps.back().added, Effect::kEncoderScale);
   std::vector<Effect> model = d.steps.back().model;
   std::sort(model.begin(), model.end());
   EXPECT_EQ(model, (std::vector<Effect>{Effect::kElasticity, Effect::kLoadCellBias}));

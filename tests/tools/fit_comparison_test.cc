@@ -1,8 +1,11 @@
 // The likelihood-ratio test of two nested fits on all samples
 // (solver/fit_comparison.h) on simulated data: it finds a hidden term, stays
 // quiet on a term the data do not hold, grows stricter when the noise is
-// larger than robot.toml says, and refuses fits it cannot compare.
+// larger than robot.toml says, and refuses fits it cannot compare; and
+// Akaike's criterion between any two fits of the same samples.
 #include "solver/fit_comparison.h"
+
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -90,6 +93,35 @@ TEST(FitComparison, RefusesFitsItCannotCompare) {
   // GIVEN a failed fit
   CalibrationResult failed;
   EXPECT_FALSE(compare_fits(f.base, failed).comparable);
+}
+
+TEST(AkaikeGain, RanksModelsByTheirDropLessTwoPerParameter) {
+  // GIVEN the catenary fit and the fit with a 4-parameter term on data without it
+  const Fits f = fit_both(large_robot(3), Effect::kEncoderScale);
+  // WHEN Akaike's criterion compares them either way
+  const double drop = 2.0 * (f.base.solver.final_cost - f.with_term.solver.final_cost);
+  // THEN it is the chi2 drop less 2 per parameter added, and its negative the other way round
+  EXPECT_DOUBLE_EQ(akaike_gain(f.base, f.with_term), drop - 8.0);
+  EXPECT_DOUBLE_EQ(akaike_gain(f.with_term, f.base), 8.0 - drop);
+  // AND the term that fits only noise is not the better model
+  EXPECT_LT(akaike_gain(f.base, f.with_term), 0.0);
+}
+
+TEST(AkaikeGain, AHiddenTermIsTheBetterModel) {
+  // GIVEN cables with EA = 1.5e6 N, WHEN the catenary fit is compared with the fit with elasticity
+  sim::DatasetConfig config = large_robot(2);
+  config.effects.axial_stiffness_n = 1.5e6;
+  const Fits f = fit_both(config, Effect::kElasticity);
+  // THEN the elasticity model gains
+  EXPECT_GT(akaike_gain(f.base, f.with_term), 10.0);
+}
+
+TEST(AkaikeGain, FitsOfDifferentSamplesOrFailedFitsNeverGain) {
+  const Fits f = fit_both(large_robot(3), Effect::kElasticity);
+  CalibrationResult fewer = f.with_term;
+  fewer.rejected_samples.push_back(7);
+  EXPECT_EQ(akaike_gain(f.base, fewer), -std::numeric_limits<double>::infinity());
+  EXPECT_EQ(akaike_gain(f.base, CalibrationResult{}), -std::numeric_limits<double>::infinity());
 }
 
 }  // namespace
