@@ -50,11 +50,11 @@ struct DiagnosisOptions {
   int folds = 3;             // cross-validation: sample k (by order) is held out in fold k % folds
   double alpha = 0.01;       // family-wise significance per round
   int max_added = 4;         // at most this many effects are added
-  // When a round has a significant candidate, also try each pair of its
-  // individually significant candidates, and add a pair instead when it
-  // predicts the held-out poses better than the best single one and its
-  // second term is significant on top of it (at alpha over the number of
-  // pairs).
+  // When a round has a significant candidate, also try pairs of its
+  // individually significant candidates and add a pair instead of the best
+  // single one when it predicts the held-out poses better, is the better
+  // model by Akaike's criterion on all samples and each of its terms is
+  // significant on top of the other (solver/pair_search.h).
   bool try_pairs = true;
   std::function<void(const std::string&)> progress;  // one line per fit; may be empty
 };
