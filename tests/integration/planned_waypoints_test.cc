@@ -16,7 +16,12 @@
 namespace cdpr::integration {
 namespace {
 
-TEST(PlannedWaypoints, TheTrueLargeRobotRestsNearEveryWaypointPlannedFromNominalAnchors) {
+// Both ways of picking the waypoints from the feasible candidates: spread
+// evenly (the default) and informative (A-optimal, crowding towards the
+// workspace's edges, where a wrong plan would show first).
+class PlannedWaypoints : public ::testing::TestWithParam<calibration::WaypointSelection> {};
+
+TEST_P(PlannedWaypoints, TheTrueLargeRobotRestsNearEveryWaypointPlannedFromNominalAnchors) {
   // GIVEN the virtual robot of the full calibration test (large, nominal anchors 0.3 m off), at rest where it starts
   const virtual_robot::VirtualRobotOptions robot_options = large_robot_acceptance_options();
   const auto data = sim::simulate_dataset(virtual_robot::dataset_config(robot_options));
@@ -28,10 +33,11 @@ TEST(PlannedWaypoints, TheTrueLargeRobotRestsNearEveryWaypointPlannedFromNominal
   std::array<double, kCableCount> encoder_m{};
   for (int i = 0; i < kCableCount; ++i) encoder_m[i] = start->cables[i].payout_m + truth.encoder_offset_m[i];
 
-  // WHEN the daemon (default settings) estimates the offsets there and plans
+  // WHEN the daemon (default settings, but the selection) estimates the offsets there and plans
   const auto offsets = calibration::estimate_payout_offsets(data->nominal, start_world, encoder_m);
   ASSERT_TRUE(offsets) << offsets.error();
-  const calibration::PlannerOptions options = daemon::default_daemon_config().calibrator.planner;
+  calibration::PlannerOptions options = daemon::default_daemon_config().calibrator.planner;
+  options.selection = GetParam();
   const auto plan = calibration::plan_waypoints(data->nominal, *offsets, start_world, options);
   ASSERT_TRUE(plan.ok()) << plan.problem;
   ASSERT_EQ(static_cast<int>(plan.waypoints.size()), options.waypoint_count);
@@ -59,6 +65,13 @@ TEST(PlannedWaypoints, TheTrueLargeRobotRestsNearEveryWaypointPlannedFromNominal
                            << physics->failed_solves() << " failed equilibrium solves so far";
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Selection, PlannedWaypoints,
+                         ::testing::Values(calibration::WaypointSelection::kSpread,
+                                           calibration::WaypointSelection::kInformative),
+                         [](const ::testing::TestParamInfo<calibration::WaypointSelection>& info) {
+                           return info.param == calibration::WaypointSelection::kSpread ? "Spread" : "Informative";
+                         });
 
 }  // namespace
 }  // namespace cdpr::integration
