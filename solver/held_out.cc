@@ -43,8 +43,8 @@ std::vector<int> global_columns(const EffectPoseFactor& factor, const Calibratio
 // reference force 2) and the globals g, J_g^T J_g - J_g^T J_l (J_l^T J_l)^-1
 // J_l^T J_g (l eliminated). Adds nothing when the pose cannot be evaluated.
 void add_held_out_information(const EffectPoseFactor& factor, const PosePriorFactor& prior,
-                            const std::vector<const double*>& blocks, const CalibrationResult& trained,
-                            const std::vector<int>& global_column, Eigen::MatrixXd& h) {
+                              const std::vector<const double*>& blocks, const CalibrationResult& trained,
+                              const std::vector<int>& global_column, Eigen::MatrixXd& h) {
   const int p = static_cast<int>(trained.global_covariance.rows());
   constexpr int kLocal = 8, kRows = EffectPoseFactor::kResidualDim + 6;
   Eigen::MatrixXd j_local = Eigen::MatrixXd::Zero(kRows, kLocal), j_global = Eigen::MatrixXd::Zero(kRows, p);
