@@ -148,7 +148,21 @@ void subtract_times_vector(int rows, int cols, const double* x, int ldx, const d
   }
 }
 
-void solve_upper_transposed_rows(int d, const double* u, int m, const double* b, double* w) {
+bool all_finite(const double* v, std::size_t n) {
+  Pair s0 = {}, s1 = {};
+  const Pair zero = {};
+  std::size_t i = 0;
+  for (; i + 4 <= n; i += 4) {
+    s0 += load(v + i) * zero;
+    s1 += load(v + i + 2) * zero;
+  }
+  double rest = 0.0;
+  for (; i < n; ++i) rest += v[i] * 0.0;
+  const Pair sum = s0 + s1;
+  return sum[0] + sum[1] + rest == 0.0;
+}
+
+void solve_upper_transposed_rows(int d, const double* u, const double* inverse, int m, const double* b, double* w) {
   int q = 0;
   // Eight columns at a time, their four pairs in registers down all d rows.
   for (; q + 8 <= m; q += 8) {
@@ -164,12 +178,12 @@ void solve_upper_transposed_rows(int d, const double* u, int m, const double* b,
         v2 -= factor * load(wp + 4);
         v3 -= factor * load(wp + 6);
       }
-      const Pair inverse = splat(1.0 / ui[i]);
+      const Pair scale = splat(inverse[i]);
       double* wi = w + i * m + q;
-      store(wi, v0 * inverse);
-      store(wi + 2, v1 * inverse);
-      store(wi + 4, v2 * inverse);
-      store(wi + 6, v3 * inverse);
+      store(wi, v0 * scale);
+      store(wi + 2, v1 * scale);
+      store(wi + 4, v2 * scale);
+      store(wi + 6, v3 * scale);
     }
   }
   for (; q < m; ++q) {
@@ -177,7 +191,7 @@ void solve_upper_transposed_rows(int d, const double* u, int m, const double* b,
       const double* ui = u + d * i;
       double v = b[i * m + q];
       for (int p = 0; p < i; ++p) v -= ui[p] * w[p * m + q];
-      w[i * m + q] = v * (1.0 / ui[i]);
+      w[i * m + q] = v * inverse[i];
     }
   }
 }

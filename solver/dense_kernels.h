@@ -10,6 +10,8 @@
 // Row-major inputs (x(k, r) = x[k * ldx + r]), column-major output
 // (out(r, c) = out[r + ldo * c]). None of it allocates.
 
+#include <cstddef>
+
 namespace cdpr {
 
 // out(r, c) += sign * sum_{k < depth} x(k, r) y(k, c) for r < rows, c < cols.
@@ -26,8 +28,15 @@ void add_transposed_times_vector(int depth, int cols, const double* x, int ldx, 
 // out[k] -= sum_{c < cols} x(k, c) v[c] for k < rows (x v).
 void subtract_times_vector(int rows, int cols, const double* x, int ldx, const double* v, double* out);
 
-// W = U'^-1 B for the d x d upper triangular U (column-major) and the
-// d x m row-major B and W (forward substitution, a whole row at a time).
-void solve_upper_transposed_rows(int d, const double* u, int m, const double* b, double* w);
+// Whether all n values are finite: x * 0 is 0 for every finite x and NaN
+// for an infinity or NaN, so one branch-free sum over pairs tells (a test
+// per value, or scalar sums, cost several times more on the solver's
+// whole Jacobian buffers).
+bool all_finite(const double* v, std::size_t n);
+
+// W = U'^-1 B for the d x d upper triangular U (column-major; `inverse`:
+// the reciprocals of its diagonal) and the d x m row-major B and W (forward
+// substitution, a whole row at a time).
+void solve_upper_transposed_rows(int d, const double* u, const double* inverse, int m, const double* b, double* w);
 
 }  // namespace cdpr

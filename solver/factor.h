@@ -9,6 +9,11 @@
 
 namespace cdpr {
 
+// Rows [first, end) of a factor's residual vector.
+struct RowRange {
+  int first = 0, end = 0;
+};
+
 class Factor {
  public:
   virtual ~Factor() = default;
@@ -26,6 +31,12 @@ class Factor {
   // the step as failed. Must not allocate.
   virtual bool evaluate(const double* const* parameters, double* residual, double* const* jacobians,
                         double* cost) const = 0;
+
+  // The rows in which the Jacobian block of keys()[k] can be nonzero: a
+  // promise that evaluate() writes exact zeros outside them at every point,
+  // so a linear system may skip them (most of a pose factor's J^T J is
+  // such zeros). All rows unless a factor knows better.
+  virtual RowRange jacobian_rows(int /*k*/) const { return {0, residual_dim()}; }
 };
 
 }  // namespace cdpr

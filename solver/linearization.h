@@ -46,6 +46,8 @@ class Linearization {
   int key_variable(int f, int k) const { return key_variable_[layout_[f].key_offset + k]; }
   int key_column(int f, int k) const { return key_column_[layout_[f].key_offset + k]; }
   int key_dim(int f, int k) const { return key_dim_[layout_[f].key_offset + k]; }
+  // The rows in which key k's Jacobian block can be nonzero (Factor::jacobian_rows).
+  RowRange key_rows(int f, int k) const { return key_rows_[layout_[f].key_offset + k]; }
   const double* residuals(int slot, int f) const { return residuals_[slot].data() + layout_[f].residual_offset; }
   const double* jacobian(int slot, int f, int k) const {
     return jacobian_pointers_[slot][layout_[f].key_offset + k];
@@ -61,12 +63,15 @@ class Linearization {
     int key_offset;       // into the per-key arrays
     int residual_dim;
     int key_count;
+    int jacobian_offset;  // into a slot's Jacobians: its non-constant keys' blocks, one after another
+    int jacobian_size;
   };
 
   const Problem& problem_;
   std::vector<int> variable_column_;
   std::vector<FactorLayout> layout_;
   std::vector<int> key_variable_, key_column_, key_dim_;  // per factor key
+  std::vector<RowRange> key_rows_;
   std::vector<const double*> parameters_;
   std::vector<double> residuals_[kSlots];
   std::vector<double> jacobians_[kSlots];

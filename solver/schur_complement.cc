@@ -20,10 +20,13 @@ bool is_per_pose(const Key& key) {
 // known at compile time (the loops unroll for the common group sizes),
 // D = 0 takes the runtime `dim`.
 
-// In-place Cholesky A = U'U of a block whose upper triangle holds A; false
-// when A is not positive definite.
+// In-place Cholesky A = U'U of a block whose upper triangle holds A, and
+// the reciprocals of U's diagonal into `inverse` (every solve with U
+// multiplies by them: a division costs as much as a dozen multiply-adds and
+// sits on the critical path of each substitution); false when A is not
+// positive definite.
 template <int D>
-bool cholesky_upper(double* u, int dim) {
+bool cholesky_upper(double* u, int dim, double* inverse) {
   const int d = D > 0 ? D : dim;
   for (int j = 0; j < d; ++j) {
     double* uj = u + d * j;
@@ -31,36 +34,37 @@ bool cholesky_upper(double* u, int dim) {
       const double* ui = u + d * i;
       double s = uj[i];
       for (int p = 0; p < i; ++p) s -= ui[p] * uj[p];
-      uj[i] = s / ui[i];
+      uj[i] = s * inverse[i];
     }
     double s = uj[j];
     for (int p = 0; p < j; ++p) s -= uj[p] * uj[p];
     if (!(s > 0.0)) return false;
     uj[j] = std::sqrt(s);
+    inverse[j] = 1.0 / uj[j];
   }
   return true;
 }
 
 // Solves U'y = b in place (forward substitution).
 template <int D>
-void solve_upper_transposed(const double* u, int dim, double* y) {
+void solve_upper_transposed(const double* u, const double* inverse, int dim, double* y) {
   const int d = D > 0 ? D : dim;
   for (int i = 0; i < d; ++i) {
     const double* ui = u + d * i;
     double s = y[i];
     for (int p = 0; p < i; ++p) s -= ui[p] * y[p];
-    y[i] = s / ui[i];
+    y[i] = s * inverse[i];
   }
 }
 
 // Solves U x = b in place (back substitution).
 template <int D>
-void solve_upper(const double* u, int dim, double* x) {
+void solve_upper(const double* u, const double* inverse, int dim, double* x) {
   const int d = D > 0 ? D : dim;
   for (int i = d - 1; i >= 0; --i) {
     double s = x[i];
     for (int p = i + 1; p < d; ++p) s -= u[i + d * p] * x[p];
-    x[i] = s / u[i + d * i];
+    x[i] = s * inverse[i];
   }
 }
 
@@ -71,15 +75,16 @@ void solve_upper(const double* u, int dim, double* x) {
 // upper triangle of the n x n S; `first` >= 0 when they are the contiguous
 // columns first, first + 1, ...).
 template <int D>
-bool eliminate_group(int dim, const double* a, double* u, const double* b, double* w, int m, const int* columns,
-                     int first, double* s, int n, double radius, double min_diagonal, double max_diagonal) {
+bool eliminate_group(int dim, const double* a, double* u, double* inverse, const double* b, double* w, int m,
+                     const int* columns, int first, double* s, int n, double radius, double min_diagonal,
+                     double max_diagonal) {
   const int d = D > 0 ? D : dim;
   for (int j = 0; j < d; ++j) {
     for (int i = 0; i <= j; ++i) u[i + d * j] = a[i + d * j];
     u[j + d * j] += std::clamp(a[j + d * j], min_diagonal, max_diagonal) / radius;
   }
-  if (!cholesky_upper<D>(u, d)) return false;
-  solve_upper_transposed_rows(d, u, m, b, w);
+  if (!cholesky_upper<D>(u, d, inverse)) return false;
+  solve_upper_transposed_rows(d, u, inverse, m, b, w);
   // S -= W'W (upper triangle).
   if (first >= 0) {
     add_transposed_product(d, m, m, w, m, w, m, s + first + static_cast<std::size_t>(n) * first, n, -1.0, true);
@@ -98,10 +103,10 @@ bool eliminate_group(int dim, const double* a, double* u, const double* b, doubl
 // The group's part of a solve, before the reduced system: y = U'^-1 b_l in
 // place, reduced right-hand side -= W'y (`first` as in eliminate_group).
 template <int D>
-void forward_group(int dim, const double* u, const double* w, int m, const int* columns, int first, double* y,
-                   double* reduced) {
+void forward_group(int dim, const double* u, const double* inverse, const double* w, int m, const int* columns,
+                   int first, double* y, double* reduced) {
   const int d = D > 0 ? D : dim;
-  solve_upper_transposed<D>(u, d, y);
+  solve_upper_transposed<D>(u, inverse, d, y);
   if (first >= 0) {
     add_transposed_times_vector(d, m, w, m, y, -1.0, reduced + first);
     return;
@@ -113,8 +118,8 @@ void forward_group(int dim, const double* u, const double* w, int m, const int* 
 
 // ... and after it: x_l = U^-1 (y - W x_g) in place.
 template <int D>
-void backward_group(int dim, const double* u, const double* w, int m, const int* columns, int first,
-                    const double* x_global, double* y) {
+void backward_group(int dim, const double* u, const double* inverse, const double* w, int m, const int* columns,
+                    int first, const double* x_global, double* y) {
   const int d = D > 0 ? D : dim;
   if (first >= 0) {
     subtract_times_vector(d, m, w, m, x_global + first, y);
@@ -125,7 +130,7 @@ void backward_group(int dim, const double* u, const double* w, int m, const int*
       y[i] -= dot;
     }
   }
-  solve_upper<D>(u, d, y);
+  solve_upper<D>(u, inverse, d, y);
 }
 
 // Calls f(std::integral_constant<int, D>) with D the group size when the
@@ -187,6 +192,43 @@ SchurComplement::BlockKernel kernel_for(int da, int db) {
   }
 }
 
+// dst(i, c) = block(i, c) for a row-major m x d block into rows of stride
+// `ld`: d fixed for the tangent sizes that occur, so each row is a few
+// moves (a generic loop, or std::copy's memmove per row, cost several
+// times more than the values).
+template <int D>
+void copy_fixed_columns(int m, const double* block, double* dst, int ld) {
+  for (int i = 0; i < m; ++i) {
+    for (int c = 0; c < D; ++c) dst[i * ld + c] = block[i * D + c];
+  }
+}
+void copy_block_columns(int m, int d, const double* block, double* dst, int ld) {
+  switch (d) {
+    case 1: return copy_fixed_columns<1>(m, block, dst, ld);
+    case 2: return copy_fixed_columns<2>(m, block, dst, ld);
+    case 3: return copy_fixed_columns<3>(m, block, dst, ld);
+    case 6: return copy_fixed_columns<6>(m, block, dst, ld);
+  }
+  for (int i = 0; i < m; ++i) {
+    for (int c = 0; c < d; ++c) dst[i * ld + c] = block[i * d + c];
+  }
+}
+
+int depth(RowRange r) { return std::max(0, r.end - r.first); }
+bool same_rows(RowRange a, RowRange b) { return a.first == b.first && a.end == b.end; }
+RowRange common_rows(RowRange a, RowRange b) { return {std::max(a.first, b.first), std::min(a.end, b.end)}; }
+RowRange hull(RowRange a, RowRange b) {
+  if (depth(a) == 0) return b;
+  if (depth(b) == 0) return a;
+  return {std::min(a.first, b.first), std::max(a.end, b.end)};
+}
+
+// What summing J^T r and J^T J over runs costs, in multiply-adds plus a
+// charge per kernel call (its set-up, loop control and the stores of its
+// tiles: a few dozen instructions, as many as about 32 multiply-adds in the
+// dense kernels). Rough on purpose: it only decides which runs to merge.
+constexpr int kCallCost = 64;
+
 }  // namespace
 
 std::unique_ptr<SchurComplement> SchurComplement::create(const Problem& problem) {
@@ -220,7 +262,11 @@ std::unique_ptr<SchurComplement> SchurComplement::create(const Problem& problem)
       group = g;
     }
   }
-  // Columns: each group's variables together (in variable order), then the globals.
+  // Columns: each group's variables together (in variable order), then the
+  // globals by key, so the variables of one kind sit side by side (all
+  // anchors, then all offsets, ...): a pose factor's Jacobian columns of a
+  // kind share their zero rows (Factor::jacobian_rows), and side by side
+  // they make one run of its J^T J.
   const int groups = static_cast<int>(group_dim.size());
   std::vector<int> next_column(groups, 0);
   int local_dim = 0;
@@ -228,13 +274,22 @@ std::unique_ptr<SchurComplement> SchurComplement::create(const Problem& problem)
     next_column[g] = local_dim;
     local_dim += group_dim[g];
   }
-  std::vector<int> variable_column(nv, -1);
-  int global_column = local_dim;
+  std::vector<int> variable_column(nv, -1), globals;
   for (int v = 0; v < nv; ++v) {
     if (variables[v].constant) continue;
-    int& column = group_of[v] >= 0 ? next_column[group_of[v]] : global_column;
-    variable_column[v] = column;
-    column += variables[v].tangent_dim;
+    if (group_of[v] < 0) {
+      globals.push_back(v);
+      continue;
+    }
+    variable_column[v] = next_column[group_of[v]];
+    next_column[group_of[v]] += variables[v].tangent_dim;
+  }
+  std::stable_sort(globals.begin(), globals.end(),
+                   [&](int a, int b) { return variables[a].key < variables[b].key; });
+  int global_column = local_dim;
+  for (int v : globals) {
+    variable_column[v] = global_column;
+    global_column += variables[v].tangent_dim;
   }
   return std::unique_ptr<SchurComplement>(
       new SchurComplement(problem, std::move(variable_column), group_of, groups));
@@ -307,6 +362,8 @@ SchurComplement::SchurComplement(const Problem& problem, std::vector<int> variab
   c_.assign(static_cast<std::size_t>(n) * n, 0.0);
   s_.assign(static_cast<std::size_t>(n) * n, 0.0);
   reduced_rhs_.assign(n, 0.0);
+  inverse_diagonal_.assign(local_dim_, 0.0);
+  reduced_inverse_diagonal_.assign(n, 0.0);
 
   // Block operations of every factor: each pair of non-constant keys once,
   // oriented so the block lands in an upper triangle or in B.
@@ -314,9 +371,10 @@ SchurComplement::SchurComplement(const Problem& problem, std::vector<int> variab
   plans_.assign(nf, FactorPlan{});
   gather_column_.assign(linearization_.key_offset(nf), -1);
   std::size_t widest = 0, gathered_size = 0;
+  RunCache run_cache;
   for (int f = 0; f < nf; ++f) {
     op_begin_.push_back(static_cast<int>(ops_.size()));
-    if (plan_gathered(f, factor_group[f], group_of)) {
+    if (plan_gathered(f, factor_group[f], group_of, run_cache)) {
       const FactorPlan& plan = plans_[f];
       const std::size_t width = plan.local_count + plan.global_count;
       widest = std::max(widest, width);
@@ -372,7 +430,7 @@ SchurComplement::SchurComplement(const Problem& problem, std::vector<int> variab
   gathered_gradient_.assign(widest, 0.0);
 }
 
-bool SchurComplement::plan_gathered(int f, int group, const std::vector<int>& group_of) {
+bool SchurComplement::plan_gathered(int f, int group, const std::vector<int>& group_of, RunCache& cache) {
   const Linearization& lin = linearization_;
   FactorPlan plan;
   plan.group = group;
@@ -401,6 +459,7 @@ bool SchurComplement::plan_gathered(int f, int group, const std::vector<int>& gr
   plan.global_count = any_global ? global_end - plan.global_begin : 0;
   const int width = plan.local_count + plan.global_count;
   std::vector<bool> filled(width, false);
+  std::vector<RowRange> column_rows(width);  // none for a gap
   for (int k = 0; k < lin.key_count(f); ++k) {
     const int v = lin.key_variable(f, k), column = lin.variable_column(v), d = lin.key_dim(f, k);
     if (column < 0) continue;
@@ -409,13 +468,123 @@ bool SchurComplement::plan_gathered(int f, int group, const std::vector<int>& gr
     for (int c = first; c < first + d; ++c) {
       if (filled[c]) return false;  // a key listed twice
       filled[c] = true;
+      column_rows[c] = lin.key_rows(f, k);
     }
     gather_column_[lin.key_offset(f) + k] = first;
   }
   plan.gaps = std::find(filled.begin(), filled.end(), false) != filled.end();
   plan.gathered = true;
   plans_[f] = plan;
+  plan_runs(f, column_rows, cache);
   return true;
+}
+
+int SchurComplement::runs_cost(const std::vector<ColumnRun>& runs) {
+  int cost = 0;
+  for (std::size_t a = 0; a < runs.size(); ++a) {
+    if (depth(runs[a].rows) > 0) cost += runs[a].width * depth(runs[a].rows) + kCallCost;
+    for (std::size_t b = a; b < runs.size(); ++b) {
+      const int d = depth(common_rows(runs[a].rows, runs[b].rows));
+      if (d == 0) continue;
+      const int entries = a == b ? runs[a].width * (runs[a].width + 1) / 2 : runs[a].width * runs[b].width;
+      cost += entries * d + kCallCost;
+    }
+  }
+  return cost;
+}
+
+// Merges neighbouring runs of the same part (per-pose or global columns)
+// while that makes the sums cheaper: runs over the same rows always (one
+// call instead of three, the same multiply-adds), a narrow run next to a
+// deep one not (its zeros would be summed over the deep one's rows).
+std::vector<SchurComplement::ColumnRun> SchurComplement::merge_runs(std::vector<ColumnRun> runs, int local_count) {
+  auto merge = [](std::vector<ColumnRun>& r, std::size_t i) {
+    r[i].width += r[i + 1].width;
+    r[i].rows = hull(r[i].rows, r[i + 1].rows);
+    r.erase(r.begin() + static_cast<std::ptrdiff_t>(i) + 1);
+  };
+  for (;;) {
+    int best = runs_cost(runs);
+    std::size_t best_at = runs.size();
+    for (std::size_t i = 0; i + 1 < runs.size(); ++i) {
+      if ((runs[i].column < local_count) != (runs[i + 1].column < local_count)) continue;
+      std::vector<ColumnRun> merged = runs;
+      merge(merged, i);
+      if (const int cost = runs_cost(merged); cost < best) {
+        best = cost;
+        best_at = i;
+      }
+    }
+    if (best_at == runs.size()) return runs;
+    merge(runs, best_at);
+  }
+}
+
+void SchurComplement::plan_runs(int f, const std::vector<RowRange>& column_rows, RunCache& cache) {
+  FactorPlan& plan = plans_[f];
+  const int width = plan.local_count + plan.global_count;
+  // Neighbouring columns of the same part and rows form a run to start
+  // with; those are merged further unless a factor before had the same
+  // columns and rows (the usual case: every pose has the same factors).
+  std::vector<ColumnRun> initial;
+  for (int c = 0; c < width; ++c) {
+    const RowRange rows = column_rows[c];
+    if (!initial.empty() && c != plan.local_count && same_rows(initial.back().rows, rows)) {
+      ++initial.back().width;
+    } else {
+      initial.push_back({c, 1, rows});
+    }
+  }
+  auto same_split = [](const std::vector<ColumnRun>& a, const std::vector<ColumnRun>& b) {
+    return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const ColumnRun& x, const ColumnRun& y) {
+      return x.column == y.column && x.width == y.width && same_rows(x.rows, y.rows);
+    });
+  };
+  auto known = std::find_if(cache.begin(), cache.end(), [&](const auto& entry) { return same_split(entry.first, initial); });
+  if (known == cache.end()) {
+    std::vector<ColumnRun> merged = merge_runs(initial, plan.local_count);
+    cache.emplace_back(std::move(initial), std::move(merged));
+    known = cache.end() - 1;
+  }
+  plan.run_begin = static_cast<int>(runs_.size());
+  runs_.insert(runs_.end(), known->second.begin(), known->second.end());
+  plan.run_end = static_cast<int>(runs_.size());
+
+  // Their products, each landing in an upper triangle (A, C) or in B.
+  const int n = global_dim_;
+  plan.product_begin = static_cast<int>(products_.size());
+  for (int a = plan.run_begin; a < plan.run_end; ++a) {
+    for (int b = a; b < plan.run_end; ++b) {
+      const ColumnRun& x = runs_[a];
+      const ColumnRun& y = runs_[b];
+      RunProduct p;
+      p.rows = common_rows(x.rows, y.rows);
+      if (depth(p.rows) == 0) continue;
+      const bool local_x = x.column < plan.local_count, local_y = y.column < plan.local_count;
+      p.upper = a == b;
+      if (local_x && local_y) {
+        const Group& group = groups_[plan.group];
+        p = {x.column, x.width, y.column, y.width, p.rows, kLocal, p.upper,
+             group.block + (plan.local_begin + x.column) + group.dim * (plan.local_begin + y.column), group.dim};
+      } else if (!local_x && !local_y) {
+        const int gx = plan.global_begin + x.column - plan.local_count;
+        const int gy = plan.global_begin + y.column - plan.local_count;
+        p = {x.column, x.width, y.column, y.width, p.rows, kGlobal, p.upper, gx + n * gy, n};
+      } else {
+        // B, stored as its transpose (column-major, leading dimension the
+        // group's coupled count): the global run's rows, the local run's columns.
+        const ColumnRun& global = local_x ? y : x;
+        const ColumnRun& local = local_x ? x : y;
+        const Group& group = groups_[plan.group];
+        const int coupled = group.coupled_end - group.coupled_begin;
+        const int position = plan.global_begin - group.first_if_contiguous(coupled_) + global.column - plan.local_count;
+        p = {global.column, global.width, local.column, local.width, p.rows, kCoupling, false,
+             group.coupling + position + coupled * (plan.local_begin + local.column), coupled};
+      }
+      products_.push_back(p);
+    }
+  }
+  plan.product_end = static_cast<int>(products_.size());
 }
 
 SchurComplement::~SchurComplement() = default;
@@ -429,36 +598,32 @@ void SchurComplement::accumulate_gathered(int slot, int f, double* gradient) {
   for (int k = 0; k < lin.key_count(f); ++k) {
     const int first = gather_column_[lin.key_offset(f) + k];
     if (first < 0) continue;
-    const int d = lin.key_dim(f, k);
-    const double* block = lin.jacobian(slot, f, k);
-    // Rows of 1 to 6 values: a plain loop (std::copy calls memmove for each).
-    for (int i = 0; i < m; ++i) {
-      double* row = j + i * width + first;
-      for (int c = 0; c < d; ++c) row[c] = block[i * d + c];
-    }
+    copy_block_columns(m, lin.key_dim(f, k), lin.jacobian(slot, f, k), j + first, width);
   }
   // J^T r, then J^T J as its blocks A (local x local), B (local x global,
-  // stored as its transpose, column-major) and C (global x global).
+  // stored as its transpose, column-major) and C (global x global), each
+  // run over the rows it reaches.
+  const double* residual = lin.residuals(slot, f);
   double* g = gathered_gradient_.data();
   std::fill(g, g + width, 0.0);
-  add_transposed_times_vector(m, width, j, width, lin.residuals(slot, f), 1.0, g);
-  const int n = global_dim_;
-  for (int c = 0; c < gc; ++c) gradient[local_dim_ + plan.global_begin + c] += g[lc + c];
-  if (gc > 0) {
-    add_transposed_product(m, gc, gc, j + lc, width, j + lc, width,
-                           c_.data() + plan.global_begin + static_cast<std::size_t>(n) * plan.global_begin, n, 1.0,
-                           true);
+  for (int r = plan.run_begin; r < plan.run_end; ++r) {
+    const ColumnRun& run = runs_[r];
+    if (depth(run.rows) == 0) continue;
+    add_transposed_times_vector(depth(run.rows), run.width, j + run.rows.first * width + run.column, width,
+                                residual + run.rows.first, 1.0, g + run.column);
   }
-  if (lc == 0) return;
-  const Group& group = groups_[plan.group];
-  for (int c = 0; c < lc; ++c) gradient[group.column + plan.local_begin + c] += g[c];
-  add_transposed_product(m, lc, lc, j, width, j, width, a_.data() + group.block + plan.local_begin * (group.dim + 1),
-                         group.dim, 1.0, true);
-  if (gc > 0) {
-    const int coupled = group.coupled_end - group.coupled_begin;
-    const int position = plan.global_begin - group.first_if_contiguous(coupled_);
-    add_transposed_product(m, gc, lc, j + lc, width, j, width,
-                           b_.data() + group.coupling + position + coupled * plan.local_begin, coupled, 1.0, false);
+  for (int c = 0; c < gc; ++c) gradient[local_dim_ + plan.global_begin + c] += g[lc + c];
+  if (lc > 0) {
+    const int first = groups_[plan.group].column + plan.local_begin;
+    for (int c = 0; c < lc; ++c) gradient[first + c] += g[c];
+  }
+  double* targets[3] = {a_.data(), b_.data(), c_.data()};
+  for (int p = plan.product_begin; p < plan.product_end; ++p) {
+    const RunProduct& product = products_[p];
+    const double* rows = j + product.rows.first * width;
+    add_transposed_product(depth(product.rows), product.width_a, product.width_b, rows + product.column_a, width,
+                           rows + product.column_b, width, targets[product.target] + product.offset, product.stride,
+                           1.0, product.upper);
   }
 }
 
@@ -506,7 +671,8 @@ FactorizationStatus SchurComplement::factorize(double radius, double min_diagona
     bool ok = false;
     for_group_dim(d, [&](auto size) {
       constexpr int D = decltype(size)::value;
-      ok = eliminate_group<D>(d, a, u, b, w, m, columns, first, s_.data(), n, radius, min_diagonal, max_diagonal);
+      ok = eliminate_group<D>(d, a, u, inverse_diagonal_.data() + g.column, b, w, m, columns, first, s_.data(), n,
+                              radius, min_diagonal, max_diagonal);
     });
     if (!ok) {
       bool finite = true;
@@ -527,7 +693,7 @@ FactorizationStatus SchurComplement::factorize(double radius, double min_diagona
       return FactorizationStatus::kFatal;
     }
   }
-  if (!cholesky_upper<0>(s_.data(), n)) {
+  if (!cholesky_upper<0>(s_.data(), n, reduced_inverse_diagonal_.data())) {
     if (message) *message = "matrix not positive definite (the reduced system over the global variables)";
     return FactorizationStatus::kNotPositiveDefinite;
   }
@@ -542,19 +708,20 @@ void SchurComplement::solve(const double* b, double* x) {
     if (x != b) std::copy(b + g.column, b + g.column + g.dim, x + g.column);
     for_group_dim(g.dim, [&](auto size) {
       constexpr int D = decltype(size)::value;
-      forward_group<D>(g.dim, factor_.data() + g.block, w_.data() + g.coupling, g.coupled_end - g.coupled_begin,
-                       coupled_.data() + g.coupled_begin, g.first_if_contiguous(coupled_), x + g.column,
-                       reduced_rhs_.data());
+      forward_group<D>(g.dim, factor_.data() + g.block, inverse_diagonal_.data() + g.column, w_.data() + g.coupling,
+                       g.coupled_end - g.coupled_begin, coupled_.data() + g.coupled_begin,
+                       g.first_if_contiguous(coupled_), x + g.column, reduced_rhs_.data());
     });
   }
-  solve_upper_transposed<0>(s_.data(), n, reduced_rhs_.data());
-  solve_upper<0>(s_.data(), n, reduced_rhs_.data());
+  solve_upper_transposed<0>(s_.data(), reduced_inverse_diagonal_.data(), n, reduced_rhs_.data());
+  solve_upper<0>(s_.data(), reduced_inverse_diagonal_.data(), n, reduced_rhs_.data());
   std::copy(reduced_rhs_.begin(), reduced_rhs_.end(), x_global);
   for (const Group& g : groups_) {
     for_group_dim(g.dim, [&](auto size) {
       constexpr int D = decltype(size)::value;
-      backward_group<D>(g.dim, factor_.data() + g.block, w_.data() + g.coupling, g.coupled_end - g.coupled_begin,
-                        coupled_.data() + g.coupled_begin, g.first_if_contiguous(coupled_), x_global, x + g.column);
+      backward_group<D>(g.dim, factor_.data() + g.block, inverse_diagonal_.data() + g.column, w_.data() + g.coupling,
+                        g.coupled_end - g.coupled_begin, coupled_.data() + g.coupled_begin,
+                        g.first_if_contiguous(coupled_), x_global, x + g.column);
     });
   }
 }

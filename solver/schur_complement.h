@@ -23,6 +23,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "solver/linearization.h"
@@ -87,9 +88,50 @@ class SchurComplement {
     BlockKernel kernel;  // compiled for (da, db) when they are common sizes
   };
 
+  // How a factor's J^T J reaches A, B and C. Gathered: its Jacobian blocks
+  // are copied into one row-major residual_dim x width matrix whose columns
+  // are a span of its group's local columns, then a span of global ones, so
+  // its whole J^T J is a few dense products written in place (the usual
+  // case). Otherwise (a global span its group does not reach contiguously,
+  // a key listed twice): one block product per pair of keys (ops_).
+  struct FactorPlan {
+    bool gathered = false;
+    int group = -1;                          // -1: no per-pose key
+    int local_begin = 0, local_count = 0;    // within the group's columns
+    int global_begin = 0, global_count = 0;  // among the global columns
+    bool gaps = false;                       // some gathered column no key fills (kept zero)
+    int run_begin = 0, run_end = 0;          // into runs_
+    int product_begin = 0, product_end = 0;  // into products_
+  };
+  // Consecutive gathered columns read over the same rows: the hull of their
+  // keys' Factor::jacobian_rows (outside it they are zero). J^T r and J^T J
+  // are summed over those rows only: a pose factor's offsets reach one row
+  // each and its load-cell row the reference force alone.
+  struct ColumnRun {
+    int column = 0, width = 0;  // within the gathered row
+    RowRange rows;
+  };
+  // One block of a gathered factor's J^T J: runs a and b over the rows both
+  // reach, added into A, B or C at `offset` with leading dimension `stride`.
+  struct RunProduct {
+    int column_a = 0, width_a = 0, column_b = 0, width_b = 0;
+    RowRange rows;
+    Target target = kLocal;
+    bool upper = false;  // a run with itself: the upper triangle
+    int offset = 0, stride = 0;
+  };
+  // Splits into runs found so far, by the split they started from (a
+  // handful: every pose has the same few kinds of factor).
+  using RunCache = std::vector<std::pair<std::vector<ColumnRun>, std::vector<ColumnRun>>>;
+
   // group_of[v]: the pose group of variable v, -1 for global or constant ones.
   // Plans the gathered J^T J of factor f (false: it takes block ops).
-  bool plan_gathered(int f, int group, const std::vector<int>& group_of);
+  bool plan_gathered(int f, int group, const std::vector<int>& group_of, RunCache& cache);
+  // Splits factor f's gathered columns (their rows: column_rows) into runs
+  // and lists their products.
+  void plan_runs(int f, const std::vector<RowRange>& column_rows, RunCache& cache);
+  static int runs_cost(const std::vector<ColumnRun>& runs);
+  static std::vector<ColumnRun> merge_runs(std::vector<ColumnRun> runs, int local_count);
   void accumulate_gathered(int slot, int f, double* gradient);
   SchurComplement(const Problem& problem, std::vector<int> variable_column, const std::vector<int>& group_of,
                   int group_count);
@@ -103,20 +145,11 @@ class SchurComplement {
   std::vector<double> a_, factor_;       // per group: J^T J block (upper), its damped Cholesky factor U (A = U'U)
   std::vector<double> b_, w_;            // per group, row-major: coupling block B, then W = U'^-1 B
   std::vector<double> c_, s_;            // global x global, column-major upper: C, then the reduced S
-  // How a factor's J^T J reaches A, B and C. Gathered: its Jacobian blocks
-  // are copied into one row-major residual_dim x width matrix whose columns
-  // are a span of its group's local columns, then a span of global ones, so
-  // its whole J^T J is three dense products written in place (the usual
-  // case). Otherwise (a global span its group does not reach contiguously,
-  // a key listed twice): one block product per pair of keys (ops_).
-  struct FactorPlan {
-    bool gathered = false;
-    int group = -1;                          // -1: no per-pose key
-    int local_begin = 0, local_count = 0;    // within the group's columns
-    int global_begin = 0, global_count = 0;  // among the global columns
-    bool gaps = false;                       // some gathered column no key fills (kept zero)
-  };
+  std::vector<double> inverse_diagonal_;          // per local column: 1 / U_jj of its group's factor
+  std::vector<double> reduced_inverse_diagonal_;  // 1 / diagonal of S's factor
   std::vector<FactorPlan> plans_;        // per factor
+  std::vector<ColumnRun> runs_;
+  std::vector<RunProduct> products_;
   std::vector<int> gather_column_;       // per factor key (Linearization's order): column in the gathered row, -1 if constant
   std::vector<double> gathered_, gathered_gradient_;  // scratch of the widest gathered factor
   std::vector<BlockOp> ops_;             // of the factors not gathered, in order

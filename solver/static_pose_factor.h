@@ -30,6 +30,12 @@ class StaticPoseFactor final : public Factor {
   std::span<const Key> keys() const override { return keys_; }
   bool evaluate(const double* const* parameters, double* residual, double* const* jacobians,
                 double* cost) const override;
+  // The pose and the anchors reach the encoder and height rows, the
+  // reference force every row and offset i only encoder row i (Eq. 14).
+  RowRange jacobian_rows(int k) const override {
+    if (k >= 2 + kCableCount) return {k - 2 - kCableCount, k - 1 - kCableCount};
+    return {0, k == 1 ? kResidualDim : 2 * kCableCount};
+  }
 
  private:
   const Robot& robot_;

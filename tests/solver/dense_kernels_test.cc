@@ -101,8 +101,9 @@ TEST(DenseKernels, RowWiseForwardSubstitutionSolvesUTransposedW) {
       u.diagonal().array() += 3.0;
       const RowMajor b = random_matrix(d, m, rng);
       RowMajor w(d, m);
+      const Eigen::VectorXd inverse = u.diagonal().cwiseInverse();
       // WHEN W = U'^-1 B row by row
-      solve_upper_transposed_rows(d, u.data(), m, b.data(), w.data());
+      solve_upper_transposed_rows(d, u.data(), inverse.data(), m, b.data(), w.data());
       // THEN U'W = B
       EXPECT_LT((u.transpose() * w - b).cwiseAbs().maxCoeff(), 1e-12) << d << " " << m;
     }

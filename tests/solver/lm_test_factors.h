@@ -1,9 +1,11 @@
 #pragma once
 // Small factors for the LM tests, on SizedFactor: an exponential curve point,
-// SE(3) prior and relative-pose factors, a cable-like range factor and a
-// linear-Gaussian factor. Their Jacobians are checked numerically in
-// lm_test_factors_test.cc.
+// SE(3) prior and relative-pose factors, a cable-like range factor, the four
+// ranges of a pose stacked, and a linear-Gaussian factor. Their Jacobians
+// are checked numerically in lm_test_factors_test.cc.
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <Eigen/Core>
@@ -155,6 +157,66 @@ class RangeFactor final : public SizedFactor<1, 6, 3, 1> {
   }
   Eigen::Vector3d attachment_platform_;
   double encoder_m_, sigma_m_;
+};
+
+// The four ranges of one pose in one factor, as StaticPoseFactor stacks a
+// pose's cables, each cable read kReadings times: rows [i R, (i + 1) R) are
+// cable i's, so anchor i and offset i reach those rows alone, which the
+// factor declares (Factor::jacobian_rows). Variables: pose (6), anchors
+// 0..3 (3 each), offsets 0..3 (1 each).
+template <int kReadings>
+class StackedRangesFactor final : public SizedFactor<4 * kReadings, 6, 3, 3, 3, 3, 1, 1, 1, 1> {
+  using Base = SizedFactor<4 * kReadings, 6, 3, 3, 3, 3, 1, 1, 1, 1>;
+  static constexpr int kRows = 4 * kReadings;
+
+ public:
+  // encoders_m[i * kReadings + r]: reading r of cable i.
+  StackedRangesFactor(int pose, const std::array<Eigen::Vector3d, 4>& attachments_platform,
+                      const std::array<double, kRows>& encoders_m, double sigma_m, Loss loss = {})
+      : Base({PoseKey(pose), AnchorKey(0), AnchorKey(1), AnchorKey(2), AnchorKey(3), OffsetKey(0), OffsetKey(1),
+              OffsetKey(2), OffsetKey(3)},
+             loss),
+        attachments_platform_(attachments_platform),
+        encoders_m_(encoders_m),
+        sigma_m_(sigma_m) {}
+
+  RowRange jacobian_rows(int k) const override {
+    if (k == 0) return {0, kRows};
+    const int cable = (k - 1) % 4;
+    return {cable * kReadings, (cable + 1) * kReadings};
+  }
+
+ private:
+  bool evaluate_whitened(const double* const* x, double* r, double* const* j) const override {
+    const Pose pose = pose_at(x[0]);
+    const Eigen::Matrix3d rotation = pose.world_R_platform.toRotationMatrix();
+    for (int i = 0; i < 4; ++i) {
+      const Eigen::Vector3d d = pose.transform(attachments_platform_[i]) - Eigen::Map<const Eigen::Vector3d>(x[1 + i]);
+      const double length = d.norm();
+      if (length < 1e-9) return false;
+      const Eigen::RowVector3d u = d.transpose() / (length * sigma_m_);
+      const Eigen::RowVector3d turn = -u * rotation * skew(attachments_platform_[i]);
+      double* anchor = j ? j[1 + i] : nullptr;
+      double* offset = j ? j[5 + i] : nullptr;
+      if (anchor) std::fill(anchor, anchor + 3 * kRows, 0.0);
+      if (offset) std::fill(offset, offset + kRows, 0.0);
+      for (int row = i * kReadings; row < (i + 1) * kReadings; ++row) {
+        r[row] = (length + x[5 + i][0] - encoders_m_[row]) / sigma_m_;
+        if (j && j[0]) {
+          for (int c = 0; c < 3; ++c) {
+            j[0][row * 6 + c] = u(c);
+            j[0][row * 6 + 3 + c] = turn(c);
+          }
+        }
+        if (anchor) for (int c = 0; c < 3; ++c) anchor[3 * row + c] = -u(c);
+        if (offset) offset[row] = 1.0 / sigma_m_;
+      }
+    }
+    return true;
+  }
+  std::array<Eigen::Vector3d, 4> attachments_platform_;
+  std::array<double, kRows> encoders_m_;
+  double sigma_m_;
 };
 
 // Linear-Gaussian: r = (A_1 x_1 + A_2 x_2 - b) / sigma, x_i 2-vectors.

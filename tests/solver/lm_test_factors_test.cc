@@ -32,6 +32,20 @@ TEST(LmTestFactors, RangeJacobianMatchesNumeric) {
                          1e-6, 1e-6);
 }
 
+TEST(LmTestFactors, StackedRangesJacobianMatchesNumericAndKeepsToItsRows) {
+  const std::array<Eigen::Vector3d, 4> attachments = {
+      {{0.5, -0.3, 0.2}, {-0.5, -0.3, 0.2}, {-0.5, 0.3, 0.2}, {0.5, 0.3, 0.2}}};
+  const std::array<double, 8> encoders = {12.0, 12.01, 11.0, 11.02, 13.0, 12.99, 12.5, 12.51};
+  std::vector<TestVariable> variables = {pose_var(some_pose(0.5)), vector_variable({8.0, 3.0, 9.0}),
+                                         vector_variable({-4.0, 3.0, 9.5}), vector_variable({-4.0, -6.0, 9.0}),
+                                         vector_variable({8.5, -6.0, 8.0})};
+  for (double offset : {0.2, -0.1, 0.0, 0.3}) variables.push_back(vector_variable({offset}));
+  expect_jacobians_match(StackedRangesFactor<2>(0, attachments, encoders, 0.001), variables, 1e-6, 1e-6);
+  // every residual beyond the Huber width
+  expect_gradient_matches_cost(StackedRangesFactor<2>(0, attachments, encoders, 0.001, Loss{2.0}), variables, 1e-7,
+                               1e-5);
+}
+
 TEST(LmTestFactors, RangeWithActiveHuberJacobianMatchesNumericOfScaledResidual) {
   // GIVEN a residual far beyond the Huber width: the factor returns s*r and s*J
   // with s frozen at the point (Ceres' corrector), so compare cost gradients.

@@ -3,6 +3,7 @@
 // perturbations of its variables (pose: d_p then d_theta on the right), to
 // check every analytic Jacobian (GTSAM factorTesting.h in spirit).
 
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -53,7 +54,9 @@ struct AnalyticEvaluation {
     std::vector<double*> blocks;
     for (std::size_t b = 0; b < vars.size(); ++b) {
       parameters.push_back(vars[b].ambient.data());
-      jacobians[b].assign(m * vars[b].tangent_dim(), 0.0);
+      // NaN, not zero: a factor must write every entry of its blocks (the
+      // solver reuses the buffers), which the checks below then see.
+      jacobians[b].assign(m * vars[b].tangent_dim(), std::numeric_limits<double>::quiet_NaN());
       blocks.push_back(jacobians[b].data());
     }
     ok = factor.evaluate(parameters.data(), residual.data(), blocks.data(), &cost);
@@ -66,6 +69,26 @@ struct AnalyticEvaluation {
         jacobians[b].data(), m, n);
   }
 };
+
+// Factor::jacobian_rows is a promise the solver builds on: exact zeros
+// outside the declared rows of every block.
+inline void expect_zero_outside_declared_rows(const Factor& factor, const AnalyticEvaluation& at) {
+  const int m = factor.residual_dim();
+  for (std::size_t b = 0; b < at.jacobians.size(); ++b) {
+    const RowRange rows = factor.jacobian_rows(static_cast<int>(b));
+    ASSERT_LE(0, rows.first) << "block " << b;
+    ASSERT_LE(rows.first, rows.end) << "block " << b;
+    ASSERT_LE(rows.end, m) << "block " << b;
+    const Eigen::MatrixXd exact = at.jacobian(b);
+    for (int r = 0; r < m; ++r) {
+      if (r >= rows.first && r < rows.end) continue;
+      for (int c = 0; c < exact.cols(); ++c) {
+        EXPECT_EQ(exact(r, c), 0.0) << "block " << b << " row " << r << " column " << c
+                                    << " is outside the declared rows [" << rows.first << ", " << rows.end << ")";
+      }
+    }
+  }
+}
 
 // Residual and cost with variable b's tangent coordinate j moved by h.
 inline bool evaluate_perturbed(const Factor& factor, const std::vector<TestVariable>& vars,
@@ -82,6 +105,7 @@ inline void expect_jacobians_match(const Factor& factor, const std::vector<TestV
                                    double tolerance) {
   const AnalyticEvaluation at(factor, vars);
   ASSERT_TRUE(at.ok);
+  expect_zero_outside_declared_rows(factor, at);
   const int m = factor.residual_dim();
   std::vector<double> plus(m), minus(m);
   double cost = 0.0;
@@ -107,6 +131,7 @@ inline void expect_gradient_matches_cost(const Factor& factor, const std::vector
                                          double tolerance) {
   const AnalyticEvaluation at(factor, vars);
   ASSERT_TRUE(at.ok);
+  expect_zero_outside_declared_rows(factor, at);
   std::vector<double> scratch(factor.residual_dim());
   double cost_plus = 0.0, cost_minus = 0.0;
   const Eigen::Map<const Eigen::VectorXd> r(at.residual.data(), factor.residual_dim());
