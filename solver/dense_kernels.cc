@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cstring>
 
+#ifdef CDPR_AVX2_KERNELS
+#include "solver/dense_kernels_avx2.h"
+#endif
+
 namespace cdpr {
 namespace {
 
@@ -106,6 +110,17 @@ void column_tiles(int depth, int row_end, int c, const double* x, int ldx, const
 
 void add_transposed_product(int depth, int rows, int cols, const double* x, int ldx, const double* y, int ldy,
                             double* out, int ldo, double sign, bool upper) {
+#ifdef CDPR_AVX2_KERNELS
+  // The J^T J and S -= W'W products are a fifth of a calibration's solve:
+  // twice the width where the processor has it, the same bits either way.
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (avx2) return avx2::add_transposed_product(depth, rows, cols, x, ldx, y, ldy, out, ldo, sign, upper);
+#endif
+  add_transposed_product_portable(depth, rows, cols, x, ldx, y, ldy, out, ldo, sign, upper);
+}
+
+void add_transposed_product_portable(int depth, int rows, int cols, const double* x, int ldx, const double* y,
+                                     int ldy, double* out, int ldo, double sign, bool upper) {
   int c = 0;
   for (; c + 4 <= cols; c += 4) {
     const int row_end = upper ? std::min(rows, c + 4) : rows;

@@ -21,6 +21,11 @@ namespace cdpr {
 void add_transposed_product(int depth, int rows, int cols, const double* x, int ldx, const double* y, int ldy,
                             double* out, int ldo, double sign, bool upper);
 
+// add_transposed_product in pairs of doubles whatever the processor (what it
+// runs where solver/dense_kernels_avx2.h does not apply; tests compare them).
+void add_transposed_product_portable(int depth, int rows, int cols, const double* x, int ldx, const double* y,
+                                     int ldy, double* out, int ldo, double sign, bool upper);
+
 // out[c] += sign * sum_{k < depth} x(k, c) v[k] for c < cols (x' v).
 void add_transposed_times_vector(int depth, int cols, const double* x, int ldx, const double* v, double sign,
                                  double* out);

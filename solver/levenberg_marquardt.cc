@@ -134,6 +134,10 @@ struct LevenbergMarquardt::Impl {
   SolverOptions options;
   std::unique_ptr<LinearSystem> system;
   std::vector<double> gradient, step, rhs, candidate;
+  // Per variable: its first column, -1 if constant (the system's, asked
+  // once: a virtual call inside the per-iteration loops kept their sums in
+  // memory).
+  std::vector<int> column_of;
   int slot = 0;  // linearisation slot of the current point
 
   Impl(Problem& p, SolverOptions o)
@@ -143,9 +147,13 @@ struct LevenbergMarquardt::Impl {
     step.assign(n, 0.0);
     rhs.assign(n, 0.0);
     candidate.assign(p.state().size(), 0.0);
+    for (std::size_t v = 0; v < p.variables().size(); ++v) {
+      column_of.push_back(system->variable_column(static_cast<int>(v)));
+    }
   }
 
-  int variable_column(int v) const { return system->variable_column(v); }
+  int variable_column(int v) const { return column_of[v]; }
+  int columns() const { return static_cast<int>(gradient.size()); }
 
   // Norm of the ambient values of the non-constant variables (Ceres' |x|).
   double free_state_norm() const {
@@ -220,7 +228,7 @@ SolverSummary LevenbergMarquardt::Impl::solve() {
     }
     bool accepted = false;
     if (status == FactorizationStatus::kSuccess) {
-      for (int c = 0; c < system->columns(); ++c) rhs[c] = -gradient[c];
+      for (int c = 0; c < columns(); ++c) rhs[c] = -gradient[c];
       system->solve(rhs.data(), step.data());
       it.step_norm = norm(step);
       const double x_norm = free_state_norm();
@@ -234,7 +242,7 @@ SolverSummary LevenbergMarquardt::Impl::solve() {
         // non-linear least squares problems", 2004, Eq. 3.9b): O(columns)
         // instead of a product with J'J.
         double g_dx = 0.0;
-        for (int c = 0; c < system->columns(); ++c) g_dx += gradient[c] * step[c];
+        for (int c = 0; c < columns(); ++c) g_dx += gradient[c] * step[c];
         const double predicted = 0.5 * (system->damping_quadratic(step.data(), radius) - g_dx);
         make_candidate();
         const int other = 1 - slot;

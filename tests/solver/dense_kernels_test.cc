@@ -1,5 +1,9 @@
 #include "solver/dense_kernels.h"
 
+#ifdef CDPR_AVX2_KERNELS
+#include "solver/dense_kernels_avx2.h"
+#endif
+
 #include <random>
 
 #include <Eigen/Dense>
@@ -66,6 +70,44 @@ TEST(DenseKernels, UpperProductFillsTheUpperTriangleAndNothingOutsideTheBlock) {
       }
     }
   }
+}
+
+// The AVX2 kernel against the portable one: the same bits for every shape
+// (each sum in the same order, no fused multiply-add), so the other tests,
+// which run whichever this processor takes, hold for both.
+TEST(DenseKernels, Avx2ProductGivesThePortableBits) {
+#ifndef CDPR_AVX2_KERNELS
+  GTEST_SKIP() << "not an x86-64 build";
+#else
+  if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this processor has no AVX2";
+  std::mt19937 rng(7);
+  int compared = 0;
+  for (int depth : {0, 1, 3, 8, 9}) {
+    for (int rows = 1; rows <= 17; ++rows) {
+      for (int cols = 1; cols <= 17; ++cols) {
+        for (bool upper : {false, true}) {
+          if (upper && rows != cols) continue;
+          const RowMajor x = random_matrix(depth, rows + 1, rng), y = random_matrix(depth, cols + 3, rng);
+          const Eigen::MatrixXd start = Eigen::MatrixXd::Random(rows + 2, cols + 1);
+          Eigen::MatrixXd portable = start, wide = start;
+          add_transposed_product_portable(depth, rows, cols, x.data() + 1, rows + 1, y.data() + 3, cols + 3,
+                                          portable.data() + 2, rows + 2, -0.5, upper);
+          avx2::add_transposed_product(depth, rows, cols, x.data() + 1, rows + 1, y.data() + 3, cols + 3,
+                                       wide.data() + 2, rows + 2, -0.5, upper);
+          for (int c = 0; c < cols + 1; ++c) {
+            for (int r = 0; r < rows + 2; ++r) {
+              // the strictly lower triangle of an upper block is scratch
+              if (upper && c >= 0 && c < cols && r >= 2 && r - 2 > c) continue;
+              ASSERT_EQ(portable(r, c), wide(r, c)) << depth << " " << rows << " " << cols << " " << upper;
+            }
+          }
+          ++compared;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(compared, 5 * (17 * 17 + 17));
+#endif
 }
 
 TEST(DenseKernels, TransposedTimesVectorAddsXTransposeV) {
