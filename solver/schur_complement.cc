@@ -68,27 +68,31 @@ void solve_upper(const double* u, const double* inverse, int dim, double* x) {
   }
 }
 
-// B and W are d x m row-major (a row per local column, contiguous over the
-// m coupled global columns), so the work below runs along contiguous rows.
-// One group's part of the factorisation: U'U = A + D_A / radius,
-// W = U'^-1 B and S -= W'W over its coupled columns (ascending, so into the
-// upper triangle of the n x n S; `first` >= 0 when they are the contiguous
-// columns first, first + 1, ...).
+// One group's damped block factorised: U'U = A + D_A / radius, in place of
+// its copy in u; false when not positive definite.
 template <int D>
-bool eliminate_group(int dim, const double* a, double* u, double* inverse, const double* b, double* w, int m,
-                     const int* columns, int first, double* s, int n, double radius, double min_diagonal,
-                     double max_diagonal) {
+bool factor_group(int dim, const double* a, double* u, double* inverse, double radius, double min_diagonal,
+                  double max_diagonal) {
   const int d = D > 0 ? D : dim;
   for (int j = 0; j < d; ++j) {
     for (int i = 0; i <= j; ++i) u[i + d * j] = a[i + d * j];
     u[j + d * j] += std::clamp(a[j + d * j], min_diagonal, max_diagonal) / radius;
   }
-  if (!cholesky_upper<D>(u, d, inverse)) return false;
+  return cholesky_upper<D>(u, d, inverse);
+}
+
+// B and W are d x m row-major (a row per local column, contiguous over the
+// m coupled global columns), so the work below runs along contiguous rows.
+// One group's elimination once U is known: W = U'^-1 B and S -= W'W over
+// its coupled columns (ascending, so into the upper triangle of the n x n
+// S; `first` >= 0 when they are the contiguous columns first, first + 1, ...).
+void eliminate_group(int d, const double* u, const double* inverse, const double* b, double* w, int m,
+                     const int* columns, int first, double* s, int n) {
   solve_upper_transposed_rows(d, u, inverse, m, b, w);
   // S -= W'W (upper triangle).
   if (first >= 0) {
     add_transposed_product(d, m, m, w, m, w, m, s + first + static_cast<std::size_t>(n) * first, n, -1.0, true);
-    return true;
+    return;
   }
   for (int i = 0; i < d; ++i) {
     const double* wi = w + i * m;
@@ -97,7 +101,6 @@ bool eliminate_group(int dim, const double* a, double* u, double* inverse, const
       for (int p = 0; p <= q; ++p) s_column[columns[p]] -= wi[p] * wi[q];
     }
   }
-  return true;
 }
 
 // The group's part of a solve, before the reduced system: y = U'^-1 b_l in
@@ -659,20 +662,18 @@ FactorizationStatus SchurComplement::factorize(double radius, double min_diagona
     const std::size_t d = c + static_cast<std::size_t>(n) * c;
     s_[d] += std::clamp(c_[d], min_diagonal, max_diagonal) / radius;
   }
+  // Every group's block first, then the eliminations: the blocks' Cholesky
+  // chains (a square root and a reciprocal per column, each waiting for the
+  // last) are independent of each other, so back to back they overlap.
   for (std::size_t gi = 0; gi < groups_.size(); ++gi) {
     const Group& g = groups_[gi];
-    const int d = g.dim, m = g.coupled_end - g.coupled_begin;
+    const int d = g.dim;
     const double* a = a_.data() + g.block;
-    double* u = factor_.data() + g.block;
-    const double* b = b_.data() + g.coupling;
-    double* w = w_.data() + g.coupling;
-    const int* columns = coupled_.data() + g.coupled_begin;
-    const int first = g.first_if_contiguous(coupled_);
     bool ok = false;
     for_group_dim(d, [&](auto size) {
       constexpr int D = decltype(size)::value;
-      ok = eliminate_group<D>(d, a, u, inverse_diagonal_.data() + g.column, b, w, m, columns, first, s_.data(), n,
-                              radius, min_diagonal, max_diagonal);
+      ok = factor_group<D>(d, a, factor_.data() + g.block, inverse_diagonal_.data() + g.column, radius, min_diagonal,
+                           max_diagonal);
     });
     if (!ok) {
       bool finite = true;
@@ -683,6 +684,11 @@ FactorizationStatus SchurComplement::factorize(double radius, double min_diagona
       }
       return finite ? FactorizationStatus::kNotPositiveDefinite : FactorizationStatus::kFatal;
     }
+  }
+  for (const Group& g : groups_) {
+    eliminate_group(g.dim, factor_.data() + g.block, inverse_diagonal_.data() + g.column, b_.data() + g.coupling,
+                    w_.data() + g.coupling, g.coupled_end - g.coupled_begin, coupled_.data() + g.coupled_begin,
+                    g.first_if_contiguous(coupled_), s_.data(), n);
   }
   // S is dense (every pose reaches every global variable it is coupled to,
   // and the globals are few): an in-place dense Cholesky beats a sparse

@@ -112,7 +112,7 @@ TEST(DenseKernels, Avx2ProductGivesThePortableBits) {
 
 TEST(DenseKernels, TransposedTimesVectorAddsXTransposeV) {
   std::mt19937 rng(5);
-  for (int cols = 1; cols <= 9; ++cols) {
+  for (int cols = 1; cols <= 19; ++cols) {  // blocks of eight columns, pairs and a single one
     const RowMajor x = random_matrix(7, cols + 1, rng);
     const Eigen::VectorXd v = Eigen::VectorXd::Random(7);
     Eigen::VectorXd out = Eigen::VectorXd::Random(cols);
