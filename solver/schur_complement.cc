@@ -461,8 +461,10 @@ bool SchurComplement::plan_gathered(int f, int group, const std::vector<int>& gr
   plan.local_count = any_local ? local_end - plan.local_begin : 0;
   plan.global_count = any_global ? global_end - plan.global_begin : 0;
   const int width = plan.local_count + plan.global_count;
-  std::vector<bool> filled(width, false);
-  std::vector<RowRange> column_rows(width);  // none for a gap
+  std::vector<bool>& filled = cache.filled;
+  std::vector<RowRange>& column_rows = cache.column_rows;
+  filled.assign(width, false);
+  column_rows.assign(width, RowRange{});
   for (int k = 0; k < lin.key_count(f); ++k) {
     const int v = lin.key_variable(f, k), column = lin.variable_column(v), d = lin.key_dim(f, k);
     if (column < 0) continue;
@@ -478,7 +480,7 @@ bool SchurComplement::plan_gathered(int f, int group, const std::vector<int>& gr
   plan.gaps = std::find(filled.begin(), filled.end(), false) != filled.end();
   plan.gathered = true;
   plans_[f] = plan;
-  plan_runs(f, column_rows, cache);
+  plan_runs(f, cache);
   return true;
 }
 
@@ -523,15 +525,16 @@ std::vector<SchurComplement::ColumnRun> SchurComplement::merge_runs(std::vector<
   }
 }
 
-void SchurComplement::plan_runs(int f, const std::vector<RowRange>& column_rows, RunCache& cache) {
+void SchurComplement::plan_runs(int f, RunCache& cache) {
   FactorPlan& plan = plans_[f];
   const int width = plan.local_count + plan.global_count;
   // Neighbouring columns of the same part and rows form a run to start
   // with; those are merged further unless a factor before had the same
   // columns and rows (the usual case: every pose has the same factors).
-  std::vector<ColumnRun> initial;
+  std::vector<ColumnRun>& initial = cache.initial;
+  initial.clear();
   for (int c = 0; c < width; ++c) {
-    const RowRange rows = column_rows[c];
+    const RowRange rows = cache.column_rows[c];
     if (!initial.empty() && c != plan.local_count && same_rows(initial.back().rows, rows)) {
       ++initial.back().width;
     } else {
@@ -543,14 +546,20 @@ void SchurComplement::plan_runs(int f, const std::vector<RowRange>& column_rows,
       return x.column == y.column && x.width == y.width && same_rows(x.rows, y.rows);
     });
   };
-  auto known = std::find_if(cache.begin(), cache.end(), [&](const auto& entry) { return same_split(entry.first, initial); });
-  if (known == cache.end()) {
-    std::vector<ColumnRun> merged = merge_runs(initial, plan.local_count);
-    cache.emplace_back(std::move(initial), std::move(merged));
-    known = cache.end() - 1;
-  }
+  auto& splits = cache.splits;
+  auto known = std::find_if(splits.begin(), splits.end(), [&](const auto& split) {
+    return same_split(split.first, initial);
+  });
   plan.run_begin = static_cast<int>(runs_.size());
-  runs_.insert(runs_.end(), known->second.begin(), known->second.end());
+  if (known != splits.end()) {
+    runs_.insert(runs_.end(), known->second.begin(), known->second.end());
+  } else {
+    const std::vector<ColumnRun> merged = merge_runs(initial, plan.local_count);
+    runs_.insert(runs_.end(), merged.begin(), merged.end());
+    // A problem of many kinds of factor would make this search long.
+    constexpr std::size_t kRememberedSplits = 16;
+    if (splits.size() < kRememberedSplits) splits.emplace_back(initial, merged);
+  }
   plan.run_end = static_cast<int>(runs_.size());
 
   // Their products, each landing in an upper triangle (A, C) or in B.

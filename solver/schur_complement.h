@@ -120,16 +120,23 @@ class SchurComplement {
     bool upper = false;  // a run with itself: the upper triangle
     int offset = 0, stride = 0;
   };
-  // Splits into runs found so far, by the split they started from (a
-  // handful: every pose has the same few kinds of factor).
-  using RunCache = std::vector<std::pair<std::vector<ColumnRun>, std::vector<ColumnRun>>>;
+  // What planning the factors one after another carries over: the splits
+  // into runs found so far, by the split they started from (a handful:
+  // every pose has the same few kinds of factor), and scratch, so planning
+  // a thousand poses allocates next to nothing.
+  struct RunCache {
+    std::vector<std::pair<std::vector<ColumnRun>, std::vector<ColumnRun>>> splits;
+    std::vector<bool> filled;            // per gathered column: a key fills it
+    std::vector<RowRange> column_rows;   // per gathered column: its key's rows (none for a gap)
+    std::vector<ColumnRun> initial;
+  };
 
   // group_of[v]: the pose group of variable v, -1 for global or constant ones.
   // Plans the gathered J^T J of factor f (false: it takes block ops).
   bool plan_gathered(int f, int group, const std::vector<int>& group_of, RunCache& cache);
-  // Splits factor f's gathered columns (their rows: column_rows) into runs
-  // and lists their products.
-  void plan_runs(int f, const std::vector<RowRange>& column_rows, RunCache& cache);
+  // Splits factor f's gathered columns (their rows: cache.column_rows) into
+  // runs and lists their products.
+  void plan_runs(int f, RunCache& cache);
   static int runs_cost(const std::vector<ColumnRun>& runs);
   static std::vector<ColumnRun> merge_runs(std::vector<ColumnRun> runs, int local_count);
   void accumulate_gathered(int slot, int f, double* gradient);
