@@ -54,32 +54,35 @@ Wrench column_v(const CableGeometry& g) {
 class Lu6 {
  public:
   explicit Lu6(const Eigen::Matrix<double, 6, 6>& a) {
+#pragma GCC unroll 6
     for (int r = 0; r < 6; ++r) {
+#pragma GCC unroll 6
       for (int c = 0; c < 6; ++c) lu_[r][c] = a(r, c);
     }
     eliminate<0>();
   }
   double determinant() const { return determinant_; }
-  // x = A^-1 b.
-  Wrench solve(const Wrench& b) const {
-    double x[6] = {b(0), b(1), b(2), b(3), b(4), b(5)};
+  // A^-1 b for one right-hand side (a Wrench) or, row-major, N of them at
+  // once: each step of the substitutions is then one row operation over
+  // all N (vectorised), where N separate solves, or an explicit inverse
+  // times b, cost about three times as many instructions.
+  template <typename Rhs>
+  Rhs solve(const Rhs& b) const {
+    static_assert(Rhs::RowsAtCompileTime == 6 && (Rhs::ColsAtCompileTime == 1 || Rhs::IsRowMajor));
+    Rhs x;
 #pragma GCC unroll 6
-    for (int k = 0; k < 6; ++k) std::swap(x[k], x[perm_[k]]);
+    for (int r = 0; r < 6; ++r) {
+      x.row(r) = b.row(row_of_[r]);
 #pragma GCC unroll 6
-    for (int r = 1; r < 6; ++r) {
-      double sum = x[r];
-#pragma GCC unroll 6
-      for (int c = 0; c < r; ++c) sum -= lu_[r][c] * x[c];
-      x[r] = sum;
+      for (int c = 0; c < r; ++c) x.row(r) -= lu_[r][c] * x.row(c);
     }
 #pragma GCC unroll 6
     for (int r = 5; r >= 0; --r) {
-      double sum = x[r];
 #pragma GCC unroll 6
-      for (int c = r + 1; c < 6; ++c) sum -= lu_[r][c] * x[c];
-      x[r] = sum * inverse_diagonal_[r];
+      for (int c = r + 1; c < 6; ++c) x.row(r) -= lu_[r][c] * x.row(c);
+      x.row(r) *= inverse_diagonal_[r];
     }
-    return Eigen::Map<const Wrench>(x);
+    return x;
   }
 
  private:
@@ -95,8 +98,8 @@ class Lu6 {
       for (int r = K + 1; r < 6; ++r) {
         if (std::abs(lu_[r][K]) > std::abs(lu_[pivot][K])) pivot = r;
       }
-      perm_[K] = pivot;
       if (pivot != K) {
+        std::swap(row_of_[K], row_of_[pivot]);
 #pragma GCC unroll 6
         for (int c = 0; c < 6; ++c) std::swap(lu_[K][c], lu_[pivot][c]);
         determinant_ = -determinant_;
@@ -121,7 +124,7 @@ class Lu6 {
 
   double lu_[6][6];
   double inverse_diagonal_[6];
-  int perm_[6] = {};
+  int row_of_[6] = {0, 1, 2, 3, 4, 5};  // row r of P A is row row_of_[r] of A
   double determinant_ = 1.0;
 };
 
@@ -146,7 +149,9 @@ StaticsStatus set_up(const Robot& robot, const StaticsInput& in, Setup& s,
     CableGeometry& g = s.geo[i];
     g.lever_world = s.R * b;
     const Eigen::Vector3d d = p + g.lever_world - in.anchor_world[i];
-    g.span = std::hypot(d.x(), d.y());
+    // Spans are metres: their squares neither overflow nor underflow, so
+    // the plain root is exact enough and costs far less than std::hypot.
+    g.span = std::sqrt(d.x() * d.x() + d.y() * d.y());
     if (!(g.span > 1e-9)) return StaticsStatus::kVerticalCable;
     g.s_c = Eigen::Vector3d(d.x() / g.span, d.y() / g.span, 0.0);
     (*span)[i] = g.span;
@@ -177,6 +182,45 @@ StaticsStatus set_up(const Robot& robot, const StaticsInput& in, Setup& s,
 // means two cables' planes coincide and Eq. (11) has no unique solution.
 bool singular(const Lu6& lu) { return !(std::abs(lu.determinant()) > 1e-12); }
 
+// Eigen fills a whole matrix with a constant by std::fill_n, a scalar loop
+// of 23 stores here; through a block view the same zeros are an unrolled,
+// vectorised assignment.
+void set_zero(StaticsRow& row) { row.segment<kStaticsParamDim>(0).setZero(); }
+
+// The right-hand sides of the statics Jacobian (see solve_platform_statics)
+// by column: u_0..3, rotation (3), centre of mass (3), reference force (2).
+constexpr int kU = 0, kRotation = 4, kCom = 7, kForce = 10;
+using RightHandSides = Eigen::Matrix<double, 6, 12, Eigen::RowMajor>;
+
+// One row of d f_rest over the statics parameters from its row of
+// G = A^-1 E (see solve_platform_statics): the rank-one terms v_i phi_i in
+// the horizontal position, rotation and anchor (x, y) columns, G's own
+// blocks in the rotation, reference-force and centre-of-mass columns, and
+// zero in the columns the forces do not depend on (height, anchor heights).
+// Every entry is written, so the row needs no zero fill first.
+void write_force_row(const RightHandSides& g, int rest, const std::array<Eigen::Matrix<double, 1, 7>, kCableCount>& phi,
+                     StaticsRow& row) {
+  double d_x = 0.0, d_y = 0.0;
+  Eigen::Matrix<double, 1, 3> d_rotation = g.block<1, 3>(rest, kRotation);
+#pragma GCC unroll 4
+  for (int i = 0; i < kCableCount; ++i) {
+    const double v = g(rest, kU + i);
+    const int anchor = kStaticsAnchor + 3 * i;
+    d_x += v * phi[i](0);
+    d_y += v * phi[i](1);
+    d_rotation += v * phi[i].segment<3>(2);
+    row(anchor) = v * phi[i](5);
+    row(anchor + 1) = v * phi[i](6);
+    row(anchor + 2) = 0.0;
+  }
+  row(kStaticsPose) = d_x;
+  row(kStaticsPose + 1) = d_y;
+  row(kStaticsPose + 2) = 0.0;
+  row.segment<3>(kStaticsPose + 3) = d_rotation;
+  row.segment<2>(kStaticsForce) = g.block<1, 2>(rest, kForce);
+  row.segment<3>(kStaticsCom) = g.block<1, 3>(rest, kCom);
+}
+
 }  // namespace
 
 StaticsStatus reference_force_map(const Robot& robot, const StaticsInput& in, ReferenceForceMap& map) {
@@ -187,9 +231,16 @@ StaticsStatus reference_force_map(const Robot& robot, const StaticsInput& in, Re
   }
   const Lu6 lu(s.A);
   if (singular(lu)) return StaticsStatus::kSingular;
-  for (int k = 0; k < 6; ++k) map.inverse.col(k) = lu.solve(Wrench::Unit(k));
-  const Wrench offset = map.inverse * s.w;
-  const Wrench gain_h = -(map.inverse * s.column_h_ref), gain_v = -(map.inverse * s.column_v_ref);
+  // A^-1 (for d_force_d_yaw) and A^-1 [w, J_h,ref, J_v,ref] in one pass.
+  Eigen::Matrix<double, 6, 9, Eigen::RowMajor> b;
+  b.leftCols<6>().setIdentity();
+  b.col(6) = s.w;
+  b.col(7) = s.column_h_ref;
+  b.col(8) = s.column_v_ref;
+  const Eigen::Matrix<double, 6, 9, Eigen::RowMajor> x = lu.solve(b);
+  map.inverse = x.leftCols<6>();
+  const Wrench offset = x.col(6);
+  const Wrench gain_h = -x.col(7), gain_v = -x.col(8);
   map.reference = robot.reference_cable;
   for (int i = 0, col = 0; i < kCableCount; ++i) {
     const CableGeometry& g = s.geo[i];
@@ -287,10 +338,9 @@ StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in,
   // and d r = -R [b]x d theta. So E is a sum of outer products u_i phi_i,
   // u_i = f_h [t; r x t], plus blocks in the rotation, centre-of-mass and
   // reference-force columns: a dozen solves with A instead of one per column.
-  // The right-hand sides, then one product with A^-1 (formed once: fixed
-  // 6x6 products beat a dozen triangular solves).
-  Eigen::Matrix<double, 6, 12> e = Eigen::Matrix<double, 6, 12>::Zero();  // u_0..3, rotation (3), CoM (3), force (2)
-  constexpr int kU = 0, kRotation = 4, kCom = 7, kForce = 10;
+  // The right-hand sides, solved together in one pass of the LU.
+  RightHandSides e;  // every entry written below; these are the only zeros:
+  e.block<3, 6>(0, kRotation).setZero();
   e.block<3, 3>(3, kRotation) = weight_n * skew3(kUp) * R * skew3(com_platform);
   std::array<Eigen::Matrix3d, kCableCount> d_lever;  // d r_i / d theta
   std::array<Eigen::Matrix<double, 1, 7>, kCableCount> phi;  // over (p_x, p_y, theta (3), a_x, a_y)
@@ -312,49 +362,33 @@ StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in,
   e.block<3, 3>(3, kCom) = -weight_n * skew3(kUp) * R;
   e.col(kForce) = -column_h_ref;
   e.col(kForce + 1) = -column_v_ref;
-  Eigen::Matrix<double, 6, 6> inverse;
-  for (int k = 0; k < 6; ++k) inverse.col(k) = lu.solve(Wrench::Unit(k));
-  const Eigen::Matrix<double, 6, 12> g = inverse * e;
-  Eigen::Matrix<double, 6, kStaticsParamDim> d_f_rest = Eigen::Matrix<double, 6, kStaticsParamDim>::Zero();
-  d_f_rest.middleCols<3>(kStaticsPose + 3) = g.middleCols<3>(kRotation);
-  d_f_rest.middleCols<3>(kStaticsCom) = g.middleCols<3>(kCom);
-  d_f_rest.middleCols<2>(kStaticsForce) = g.middleCols<2>(kForce);
-  std::array<Wrench, kCableCount> v;  // A^-1 u_i
-  for (int i = 0; i < kCableCount; ++i) v[i] = g.col(kU + i);
-  for (int i = 0; i < kCableCount; ++i) {
-    const int anchor = kStaticsAnchor + 3 * i;
-    d_f_rest.col(kStaticsPose) += v[i] * phi[i](0);
-    d_f_rest.col(kStaticsPose + 1) += v[i] * phi[i](1);
-    d_f_rest.middleCols<3>(kStaticsPose + 3) += v[i] * phi[i].segment<3>(2);
-    d_f_rest.col(anchor) += v[i] * phi[i](5);
-    d_f_rest.col(anchor + 1) += v[i] * phi[i](6);
-  }
+  const RightHandSides solved = lu.solve(e);  // G = A^-1 E, v_i = A^-1 u_i in its first columns
 
   for (int i = 0, col = 0; i < kCableCount; ++i) {
     CableStatics& c = cables[i];
     const CableGeometry& g = geo[i];
     const int anchor = kStaticsAnchor + 3 * i;
     // span = |P d|: d span = s_c' d d.
-    c.d_span.setZero();
+    set_zero(c.d_span);
     c.d_span(kStaticsPose) = g.s_c.x();
     c.d_span(kStaticsPose + 1) = g.s_c.y();
     c.d_span.segment<3>(kStaticsPose + 3) = g.s_c.transpose() * d_lever[i];
     c.d_span(anchor) = -g.s_c.x();
     c.d_span(anchor + 1) = -g.s_c.y();
-    c.d_anchor_z.setZero();
+    set_zero(c.d_anchor_z);
     c.d_anchor_z(anchor + 2) = 1.0;
     // The attachment moves with the pose, not with the anchor.
-    c.d_attachment_z.setZero();
+    set_zero(c.d_attachment_z);
     c.d_attachment_z(kStaticsPose + 2) = 1.0;
     c.d_attachment_z.segment<3>(kStaticsPose + 3) = d_lever[i].row(2);
     if (i == ref) {
-      c.d_f_h.setZero();
-      c.d_f_v.setZero();
+      set_zero(c.d_f_h);
+      set_zero(c.d_f_v);
       c.d_f_h(kStaticsForce) = 1.0;
       c.d_f_v(kStaticsForce + 1) = 1.0;
     } else {
-      c.d_f_h = d_f_rest.row(col++);
-      c.d_f_v = d_f_rest.row(col++);
+      write_force_row(solved, col++, phi, c.d_f_h);
+      write_force_row(solved, col++, phi, c.d_f_v);
     }
   }
   return StaticsStatus::kOk;
