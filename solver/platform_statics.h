@@ -33,9 +33,11 @@ struct CableStatics {
   double span = 0.0;          // [m] L_i, horizontal anchor-attachment distance
   double anchor_z = 0.0;      // [m]
   double attachment_z = 0.0;  // [m] world height of the attachment point
-  // Rows over the statics parameters. The geometry's are zero outside the
-  // pose's columns and (span, anchor_z) this cable's own anchor's, whatever
-  // the forces (StaticPoseFactor sums only the rows that reach a block).
+  // Rows over the statics parameters. The geometry's reach few columns,
+  // whatever the forces: the span's the pose's and this cable's own
+  // anchor's, the anchor height's that anchor's alone, the attachment
+  // height's the pose's alone; zero elsewhere (StaticPoseFactor sums only
+  // the rows that reach a block).
   StaticsRow d_f_h, d_f_v, d_span, d_anchor_z, d_attachment_z;
 };
 

@@ -13,44 +13,54 @@ namespace {
 constexpr std::array<int, StaticPoseFactor::kKeyCount> kBlockDims = {6, 2, 3, 3, 3, 3, 1, 1, 1, 1};
 
 // One residual row's derivative as the chain rule through a cable's catenary
-// inputs: sum_k weight[k] * (d f_h, d f_v, d span, d anchor_z,
-// d attachment_z)[k], each a statics row.
+// inputs: sum_k weight[k] * (d f_h, d f_v, d span, d anchor_z)[k], each a
+// statics row (plus the attachment height's row for the height residual).
 struct ChainWeights {
-  double f_h = 0.0, f_v = 0.0, span = 0.0, anchor_z = 0.0, attachment_z = 0.0;
+  double f_h = 0.0, f_v = 0.0, span = 0.0, anchor_z = 0.0;
 };
 
-// Row r of the factor's Jacobian blocks (pose, reference force, anchors;
-// zero in the offsets) for cable `cable`, straight from its statics rows.
-// Only the forces depend on everything; the geometry does not: the span
-// and anchor height depend on the pose and the cable's own anchor, the
-// attachment height on the pose alone, none of them on the reference
-// force. So each block sums only the rows that reach it, instead of five
-// 23-wide rows scaled, added and copied (nearly a third of the factor's
-// instructions went there).
-void write_chain_row(const CableStatics& c, int cable, const ChainWeights& w, int r, double* const* jacobians) {
+// Rows `cable` (encoder, Eq. 14) and kCableCount + cable (height, Eq. 15) of
+// the factor's Jacobian blocks (pose, reference force, anchors; zero in the
+// offsets), straight from the cable's statics rows; the height row adds
+// `height_attachment_z` times the attachment height's row. Only the forces
+// depend on everything; the geometry does not (platform_statics.h): the
+// span depends on the pose and the cable's own anchor, the anchor height on
+// that anchor alone, the attachment height on the pose alone, none of them
+// on the reference force. So each block sums only the rows that reach it,
+// instead of five 23-wide rows scaled, added and copied (nearly a third of
+// the factor's instructions went there). Both rows at once share the loads
+// of the statics rows, and whole segments let Eigen vectorise the sums.
+void write_chain_rows(const CableStatics& c, int cable, const ChainWeights& encoder, const ChainWeights& height,
+                      double height_attachment_z, double* const* jacobians) {
   static_assert(kStaticsPose == 0 && kStaticsForce == 6 && kStaticsAnchor == 8);
+  const int encoder_row = cable, height_row = kCableCount + cable;
   if (double* pose = jacobians[0]) {
-    for (int k = 0; k < 6; ++k) {
-      pose[r * 6 + k] = w.f_h * c.d_f_h(k) + w.f_v * c.d_f_v(k) + w.span * c.d_span(k) +
-                        w.anchor_z * c.d_anchor_z(k) + w.attachment_z * c.d_attachment_z(k);
-    }
+    const auto f_h = c.d_f_h.head<6>(), f_v = c.d_f_v.head<6>(), span = c.d_span.head<6>();
+    Eigen::Map<Eigen::Matrix<double, 1, 6>>(pose + encoder_row * 6) =
+        encoder.f_h * f_h + encoder.f_v * f_v + encoder.span * span;
+    Eigen::Map<Eigen::Matrix<double, 1, 6>>(pose + height_row * 6) =
+        height.f_h * f_h + height.f_v * f_v + height.span * span + height_attachment_z * c.d_attachment_z.head<6>();
   }
   if (double* force = jacobians[1]) {
-    for (int k = 0; k < 2; ++k) {
-      force[r * 2 + k] = w.f_h * c.d_f_h(kStaticsForce + k) + w.f_v * c.d_f_v(kStaticsForce + k);
-    }
+    const auto f_h = c.d_f_h.segment<2>(kStaticsForce), f_v = c.d_f_v.segment<2>(kStaticsForce);
+    Eigen::Map<Eigen::Matrix<double, 1, 2>>(force + encoder_row * 2) = encoder.f_h * f_h + encoder.f_v * f_v;
+    Eigen::Map<Eigen::Matrix<double, 1, 2>>(force + height_row * 2) = height.f_h * f_h + height.f_v * f_v;
   }
   for (int i = 0; i < kCableCount; ++i) {
     if (double* anchor = jacobians[2 + i]) {
       const int first = kStaticsAnchor + 3 * i;
-      for (int k = 0; k < 3; ++k) anchor[r * 3 + k] = w.f_h * c.d_f_h(first + k) + w.f_v * c.d_f_v(first + k);
+      const auto f_h = c.d_f_h.segment<3>(first), f_v = c.d_f_v.segment<3>(first);
+      Eigen::Map<Eigen::Matrix<double, 1, 3>> encoder_part(anchor + encoder_row * 3);
+      Eigen::Map<Eigen::Matrix<double, 1, 3>> height_part(anchor + height_row * 3);
+      encoder_part = encoder.f_h * f_h + encoder.f_v * f_v;
+      height_part = height.f_h * f_h + height.f_v * f_v;
       if (i == cable) {
-        for (int k = 0; k < 3; ++k) {
-          anchor[r * 3 + k] += w.span * c.d_span(first + k) + w.anchor_z * c.d_anchor_z(first + k);
-        }
+        const auto span = c.d_span.segment<3>(first), anchor_z = c.d_anchor_z.segment<3>(first);
+        encoder_part += encoder.span * span + encoder.anchor_z * anchor_z;
+        height_part += height.span * span + height.anchor_z * anchor_z;
       }
     }
-    if (jacobians[2 + kCableCount + i]) jacobians[2 + kCableCount + i][r] = 0.0;
+    if (double* offset = jacobians[2 + kCableCount + i]) offset[encoder_row] = offset[height_row] = 0.0;
   }
 }
 
@@ -109,11 +119,9 @@ bool StaticPoseFactor::evaluate(const double* const* parameters, double* residua
     const Eigen::Matrix<double, 1, 4>& dl = shape.d_arc_length;
     const Eigen::Matrix<double, 1, 4>& dz = shape.d_end_height;
     const double to_encoder = 1.0 / sigma_encoder, to_height = 1.0 / sigma_height_m_;
-    write_chain_row(c, i, {dl(0) * to_encoder, dl(1) * to_encoder, dl(2) * to_encoder, dl(3) * to_encoder, 0.0}, i,
-                    jacobians);
-    write_chain_row(c, i,
-                    {-dz(0) * to_height, -dz(1) * to_height, -dz(2) * to_height, -dz(3) * to_height, to_height},
-                    kCableCount + i, jacobians);
+    write_chain_rows(c, i, {dl(0) * to_encoder, dl(1) * to_encoder, dl(2) * to_encoder, dl(3) * to_encoder},
+                     {-dz(0) * to_height, -dz(1) * to_height, -dz(2) * to_height, -dz(3) * to_height}, to_height,
+                     jacobians);
     if (jacobians[2 + kCableCount + i]) jacobians[2 + kCableCount + i][i] = 1.0 / sigma_encoder;
   }
 
