@@ -51,6 +51,7 @@ CatenaryOutput evaluate_catenary(const CatenaryInput& in, bool with_jacobian) {
 
   const double dm[3] = {du1_dfh - dq_dk * dk_dfh, du1_dfv, -dq_dspan};
   const double dS[3] = {dS_dk * dk_dfh, 0.0, dS_dspan};
+#pragma GCC unroll 3
   for (int j = 0; j < 3; ++j) {
     out.d_end_height(j) = 2.0 * (cosh_m * S * dm[j] + sinh_m * dS[j]);
     out.d_arc_length(j) = 2.0 * (sinh_m * S * dm[j] + cosh_m * dS[j]);

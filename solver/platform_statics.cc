@@ -10,20 +10,6 @@ using Wrench = Eigen::Matrix<double, 6, 1>;
 
 const Eigen::Vector3d kUp = Eigen::Vector3d::UnitZ();
 
-Eigen::Matrix3d skew3(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m(0, 0) = 0.0;
-  m(0, 1) = -v.z();
-  m(0, 2) = v.y();
-  m(1, 0) = v.z();
-  m(1, 1) = 0.0;
-  m(1, 2) = -v.x();
-  m(2, 0) = -v.y();
-  m(2, 1) = v.x();
-  m(2, 2) = 0.0;
-  return m;
-}
-
 // Per-cable geometry shared by the forces and the Jacobians.
 struct CableGeometry {
   Eigen::Vector3d lever_world;  // r_i = R b_i
@@ -341,25 +327,39 @@ StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in,
   // The right-hand sides, solved together in one pass of the LU.
   RightHandSides e;  // every entry written below; these are the only zeros:
   e.block<3, 6>(0, kRotation).setZero();
-  e.block<3, 3>(3, kRotation) = weight_n * skew3(kUp) * R * skew3(com_platform);
-  std::array<Eigen::Matrix3d, kCableCount> d_lever;  // d r_i / d theta
+  // d r_i = -R [b_i]x d theta, so a' d r_i / d theta = (b_i x R'a)' for any
+  // world vector a. The rotation block, weight [z]x R [c]x - sum_i [F_i]x R [b_i]x,
+  // is R N with N = weight [z_p]x [c]x - sum_i [R'F_i]x [b_i]x (as
+  // [a]x R = R [R'a]x) and [u]x [v]x = v u' - (u'v) I: outer products in the
+  // platform frame and one 3x3 product, instead of two per cable.
+  const Eigen::Vector3d up_platform = R.row(2).transpose();  // z_p = R'z
+  Eigen::Matrix3d n = weight_n * (com_platform * up_platform.transpose());
+  n.diagonal().array() -= weight_n * up_platform.dot(com_platform);
+  std::array<Eigen::Vector3d, kCableCount> s_c_platform;  // R's_c
   std::array<Eigen::Matrix<double, 1, 7>, kCableCount> phi;  // over (p_x, p_y, theta (3), a_x, a_y)
   for (int i = 0; i < kCableCount; ++i) {
     const CableGeometry& g = geo[i];
-    d_lever[i] = -R * skew3(robot.winches[i].attachment_platform);
+    const Eigen::Vector3d& b = robot.winches[i].attachment_platform;
     const Eigen::Vector3d t(-g.s_c.y(), g.s_c.x(), 0.0);
+    s_c_platform[i] = R.transpose() * g.s_c;
+    const Eigen::Vector3d t_platform = R.transpose() * t;
     const double f_h = cables[i].f_h;
-    const Eigen::Vector3d force = -f_h * g.s_c + cables[i].f_v * kUp;
+    const Eigen::Vector3d force_platform = -f_h * s_c_platform[i] + cables[i].f_v * up_platform;
     phi[i](0) = t.x() / g.span;
     phi[i](1) = t.y() / g.span;
-    phi[i].segment<3>(2) = (t.transpose() * d_lever[i]) / g.span;
+    phi[i].segment<3>(2) = b.cross(t_platform).transpose() / g.span;
     phi[i](5) = -t.x() / g.span;
     phi[i](6) = -t.y() / g.span;
     e.col(kU + i).head<3>() = f_h * t;
     e.col(kU + i).tail<3>() = f_h * g.lever_world.cross(t);
-    e.block<3, 3>(3, kRotation) += skew3(force) * d_lever[i];
+    n -= b * force_platform.transpose();
+    n.diagonal().array() += force_platform.dot(b);
   }
-  e.block<3, 3>(3, kCom) = -weight_n * skew3(kUp) * R;
+  e.block<3, 3>(3, kRotation) = R * n;
+  // -weight [z]x R: z x (R v) = (-(R v)_y, (R v)_x, 0).
+  e.block<1, 3>(3, kCom) = weight_n * R.row(1);
+  e.block<1, 3>(4, kCom) = -weight_n * R.row(0);
+  e.block<1, 3>(5, kCom).setZero();
   e.col(kForce) = -column_h_ref;
   e.col(kForce + 1) = -column_v_ref;
   const RightHandSides solved = lu.solve(e);  // G = A^-1 E, v_i = A^-1 u_i in its first columns
@@ -372,7 +372,7 @@ StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in,
     set_zero(c.d_span);
     c.d_span(kStaticsPose) = g.s_c.x();
     c.d_span(kStaticsPose + 1) = g.s_c.y();
-    c.d_span.segment<3>(kStaticsPose + 3) = g.s_c.transpose() * d_lever[i];
+    c.d_span.segment<3>(kStaticsPose + 3) = robot.winches[i].attachment_platform.cross(s_c_platform[i]).transpose();
     c.d_span(anchor) = -g.s_c.x();
     c.d_span(anchor + 1) = -g.s_c.y();
     set_zero(c.d_anchor_z);
@@ -380,7 +380,7 @@ StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in,
     // The attachment moves with the pose, not with the anchor.
     set_zero(c.d_attachment_z);
     c.d_attachment_z(kStaticsPose + 2) = 1.0;
-    c.d_attachment_z.segment<3>(kStaticsPose + 3) = d_lever[i].row(2);
+    c.d_attachment_z.segment<3>(kStaticsPose + 3) = robot.winches[i].attachment_platform.cross(up_platform).transpose();
     if (i == ref) {
       set_zero(c.d_f_h);
       set_zero(c.d_f_v);
