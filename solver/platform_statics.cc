@@ -184,8 +184,8 @@ using RightHandSides = Eigen::Matrix<double, 6, 12, Eigen::RowMajor>;
 // blocks in the rotation, reference-force and centre-of-mass columns, and
 // zero in the columns the forces do not depend on (height, anchor heights).
 // Every entry is written, so the row needs no zero fill first.
-void write_force_row(const RightHandSides& g, int rest, const std::array<Eigen::Matrix<double, 1, 7>, kCableCount>& phi,
-                     StaticsRow& row) {
+void write_force_derivative_row(const RightHandSides& g, int rest,
+                                const std::array<Eigen::Matrix<double, 1, 7>, kCableCount>& phi, StaticsRow& row) {
   double d_x = 0.0, d_y = 0.0;
   Eigen::Matrix<double, 1, 3> d_rotation = g.block<1, 3>(rest, kRotation);
 #pragma GCC unroll 4
@@ -387,8 +387,8 @@ StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in,
       c.d_f_h(kStaticsForce) = 1.0;
       c.d_f_v(kStaticsForce + 1) = 1.0;
     } else {
-      write_force_row(solved, col++, phi, c.d_f_h);
-      write_force_row(solved, col++, phi, c.d_f_v);
+      write_force_derivative_row(solved, col++, phi, c.d_f_h);
+      write_force_derivative_row(solved, col++, phi, c.d_f_v);
     }
   }
   return StaticsStatus::kOk;

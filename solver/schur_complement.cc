@@ -196,24 +196,23 @@ SchurComplement::BlockKernel kernel_for(int da, int db) {
 }
 
 // dst(i, c) = block(i, c) for a row-major m x d block into rows of stride
-// `ld`: d fixed for the tangent sizes that occur, so each row is a few
-// moves (a generic loop, or std::copy's memmove per row, cost several
-// times more than the values).
+// `ld`: d fixed for the tangent sizes that occur (D > 0), so each row is a
+// few moves (a generic loop, or std::copy's memmove per row, cost several
+// times more than the values); D = 0 takes the runtime `dim`.
 template <int D>
-void copy_fixed_columns(int m, const double* block, double* dst, int ld) {
+void copy_block_columns(int m, int dim, const double* block, double* dst, int ld) {
+  const int d = D > 0 ? D : dim;
   for (int i = 0; i < m; ++i) {
-    for (int c = 0; c < D; ++c) dst[i * ld + c] = block[i * D + c];
+    for (int c = 0; c < d; ++c) dst[i * ld + c] = block[i * d + c];
   }
 }
 void copy_block_columns(int m, int d, const double* block, double* dst, int ld) {
   switch (d) {
-    case 1: return copy_fixed_columns<1>(m, block, dst, ld);
-    case 2: return copy_fixed_columns<2>(m, block, dst, ld);
-    case 3: return copy_fixed_columns<3>(m, block, dst, ld);
-    case 6: return copy_fixed_columns<6>(m, block, dst, ld);
-  }
-  for (int i = 0; i < m; ++i) {
-    for (int c = 0; c < d; ++c) dst[i * ld + c] = block[i * d + c];
+    case 1: return copy_block_columns<1>(m, d, block, dst, ld);
+    case 2: return copy_block_columns<2>(m, d, block, dst, ld);
+    case 3: return copy_block_columns<3>(m, d, block, dst, ld);
+    case 6: return copy_block_columns<6>(m, d, block, dst, ld);
+    default: return copy_block_columns<0>(m, d, block, dst, ld);
   }
 }
 
@@ -569,19 +568,18 @@ void SchurComplement::plan_runs(int f, RunCache& cache) {
     for (int b = a; b < plan.run_end; ++b) {
       const ColumnRun& x = runs_[a];
       const ColumnRun& y = runs_[b];
-      RunProduct p;
-      p.rows = common_rows(x.rows, y.rows);
-      if (depth(p.rows) == 0) continue;
+      const RowRange rows = common_rows(x.rows, y.rows);
+      if (depth(rows) == 0) continue;
       const bool local_x = x.column < plan.local_count, local_y = y.column < plan.local_count;
-      p.upper = a == b;
       if (local_x && local_y) {
         const Group& group = groups_[plan.group];
-        p = {x.column, x.width, y.column, y.width, p.rows, kLocal, p.upper,
-             group.block + (plan.local_begin + x.column) + group.dim * (plan.local_begin + y.column), group.dim};
+        products_.push_back({x.column, x.width, y.column, y.width, rows, kLocal, a == b,
+                             group.block + (plan.local_begin + x.column) + group.dim * (plan.local_begin + y.column),
+                             group.dim});
       } else if (!local_x && !local_y) {
         const int gx = plan.global_begin + x.column - plan.local_count;
         const int gy = plan.global_begin + y.column - plan.local_count;
-        p = {x.column, x.width, y.column, y.width, p.rows, kGlobal, p.upper, gx + n * gy, n};
+        products_.push_back({x.column, x.width, y.column, y.width, rows, kGlobal, a == b, gx + n * gy, n});
       } else {
         // B, stored as its transpose (column-major, leading dimension the
         // group's coupled count): the global run's rows, the local run's columns.
@@ -590,10 +588,9 @@ void SchurComplement::plan_runs(int f, RunCache& cache) {
         const Group& group = groups_[plan.group];
         const int coupled = group.coupled_end - group.coupled_begin;
         const int position = plan.global_begin - group.first_if_contiguous(coupled_) + global.column - plan.local_count;
-        p = {global.column, global.width, local.column, local.width, p.rows, kCoupling, false,
-             group.coupling + position + coupled * (plan.local_begin + local.column), coupled};
+        products_.push_back({global.column, global.width, local.column, local.width, rows, kCoupling, false,
+                             group.coupling + position + coupled * (plan.local_begin + local.column), coupled});
       }
-      products_.push_back(p);
     }
   }
   plan.product_end = static_cast<int>(products_.size());
