@@ -9,9 +9,12 @@
 // bias/gain correction here: those are calibration effects, DESIGN.md).
 // Time: time_us is the local monotonic time (hal::Clock of the driver) when the
 // reply arrived.
-// Thread safety: one thread at a time per instance. Real-time safety: read()
-// blocks for a bus transaction, at most response_timeout x (1 + retries) of the
-// driver's configuration; not real-time safe. open() may block longer.
+// Thread safety: one thread at a time per instance. Real-time safety: a bus
+// driver's read() blocks for a transaction, at most response_timeout x
+// (1 + retries) of its configuration, and open() may block longer; the daemon
+// therefore runs the bus driver behind drivers/common/load_cell_reader.h,
+// whose read() never blocks and returns the latest reading, possibly the same
+// one again (compare time_us).
 
 #include "hal/clock.h"
 #include "hal/status.h"

@@ -22,12 +22,14 @@
 
 #include "drivers/can/canopen_winch_bank.h"
 #include "drivers/clock/monotonic_clock.h"
+#include "drivers/common/load_cell_reader.h"
 #include "drivers/modbus/modbus_load_cell.h"
 #include "drivers/pose/pose_stream_source.h"
 #ifdef CDPR_HAVE_GPIOD
 #include "drivers/button/gpio_button.h"
 #endif
 #include "src/daemon/daemon_config.h"
+#include "src/load_cell_driver_config.h"
 #include "src/daemon/daemon_loop.h"
 #include "src/formats/robot_toml.h"
 
@@ -77,22 +79,6 @@ drivers::can::CanWinchBankConfig winch_bank_config(const daemon::WinchesConfig& 
   return out;
 }
 
-drivers::modbus::ModbusLoadCellConfig load_cell_config(const daemon::LoadCellConfig& c) {
-  drivers::modbus::ModbusLoadCellConfig out;
-  out.endpoint = c.endpoint;
-  out.baud = c.baud;
-  out.parity = c.parity;
-  out.data_bits = c.data_bits;
-  out.stop_bits = c.stop_bits;
-  out.slave_id = c.slave_id;
-  out.register_kind = c.input_registers ? drivers::modbus::RegisterKind::kInput : drivers::modbus::RegisterKind::kHolding;
-  out.first_register = c.first_register;
-  out.word_order = c.low_word_first ? drivers::modbus::WordOrder::kLowWordFirst : drivers::modbus::WordOrder::kHighWordFirst;
-  out.response_timeout_us = c.response_timeout_us;
-  out.retries = c.retries;
-  return out;
-}
-
 std::unique_ptr<hal::Button> open_button(const daemon::ButtonConfig& c) {
   if (!c.gpio) return nullptr;
 #ifdef CDPR_HAVE_GPIOD
@@ -128,7 +114,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   const drivers::can::CanWinchBankConfig winch_config = winch_bank_config(config->winches);
-  const drivers::modbus::ModbusLoadCellConfig cell_config = load_cell_config(config->load_cell);
+  const drivers::modbus::ModbusLoadCellConfig cell_config = daemon::load_cell_driver_config(config->load_cell);
   for (const std::string& problem : {drivers::can::validate(winch_config), drivers::modbus::validate(cell_config)}) {
     if (!problem.empty()) {
       log_line("configuration " + config_path + ": " + problem);
@@ -144,7 +130,12 @@ int main(int argc, char** argv) {
 
   drivers::MonotonicClock clock;
   drivers::can::CanopenWinchBank winches(winch_config, drivers::can::make_can_connector(config->winches.endpoint));
-  drivers::modbus::ModbusLoadCell load_cell(cell_config, clock);
+  drivers::modbus::ModbusLoadCell modbus_load_cell(cell_config, clock);
+  // The Modbus transaction (up to response timeout x tries) runs on the
+  // reader's thread, never in the 20 ms loop.
+  drivers::LoadCellReader load_cell(modbus_load_cell, clock,
+                                    {config->load_cell.poll_interval_us, config->load_cell.fault_timeout_us,
+                                     daemon::DaemonLoop::kReconnectIntervalUs});
   drivers::pose::PoseStreamSource pose(config->pose.endpoint, clock, config->pose.connect_timeout_us);
   const std::unique_ptr<hal::Button> button = open_button(config->button);
 

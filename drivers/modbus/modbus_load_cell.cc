@@ -28,6 +28,11 @@ bool parse_tcp(const std::string& rest, TcpEndpoint& out) {
   return true;
 }
 
+// A Modbus exception reply (function code | 0x80), as libmodbus reports it.
+bool is_exception(int error_number) {
+  return error_number > MODBUS_ENOBASE && error_number < MODBUS_ENOBASE + MODBUS_EXCEPTION_MAX;
+}
+
 }  // namespace
 
 std::string validate(const ModbusLoadCellConfig& c) {
@@ -43,8 +48,13 @@ std::string validate(const ModbusLoadCellConfig& c) {
   } else {
     return "endpoint '" + c.endpoint + "': expected tcp:<host>:<port> or rtu:<device>";
   }
-  if (c.slave_id < 0 || c.slave_id > 247) return "slave_id must be 0..247";
-  if (c.first_register < 0 || c.first_register > 0xFFFF - kTensionRegisterCount + 1) return "first_register out of range";
+  if (c.endpoint.starts_with("rtu:") && (c.slave_id < 1 || c.slave_id > 247)) {
+    return "slave_id " + std::to_string(c.slave_id) + " on RTU must be 1..247 (0 is broadcast, 248..255 reserved)";
+  }
+  if (c.endpoint.starts_with("tcp:") && !((c.slave_id >= 0 && c.slave_id <= 247) || c.slave_id == 255)) {
+    return "slave_id " + std::to_string(c.slave_id) + " on TCP must be 0..247 or 255";
+  }
+  if (std::string problem = validate(c.map); !problem.empty()) return problem;
   if (c.response_timeout_us <= 0) return "response timeout must be positive";
   if (c.retries < 0 || c.retries > 10) return "retries must be 0..10";
   return {};
@@ -131,18 +141,24 @@ void ModbusLoadCell::close() {
   connected_ = false;
 }
 
-hal::Status ModbusLoadCell::try_read(std::uint16_t (&registers)[kTensionRegisterCount]) {
+hal::Status ModbusLoadCell::try_read(std::uint16_t (&registers)[kMaxSpanRegisters]) {
   ++counters_.requests;
+  const RegisterSpan span = register_span(config_.map);
   const int n = config_.register_kind == RegisterKind::kHolding
-                    ? modbus_read_registers(context_, config_.first_register, kTensionRegisterCount, registers)
-                    : modbus_read_input_registers(context_, config_.first_register, kTensionRegisterCount, registers);
-  if (n == kTensionRegisterCount) return hal::Status::Ok();
+                    ? modbus_read_registers(context_, span.first, span.count, registers)
+                    : modbus_read_input_registers(context_, span.first, span.count, registers);
+  if (n == span.count) return hal::Status::Ok();
   if (n >= 0) {
     ++counters_.other_errors;
     return hal::Status(hal::ErrorCode::kProtocolError, config_.endpoint + ": short reply (" + std::to_string(n) +
                                                            " registers)");
   }
-  const hal::Status error = modbus_error_status(errno, config_.endpoint, "read registers");
+  const int error_number = errno;
+  const hal::Status error = modbus_error_status(error_number, config_.endpoint, "read registers");
+  if (is_exception(error_number)) {
+    ++counters_.exceptions;
+    return error;
+  }
   switch (error.code()) {
     case hal::ErrorCode::kTimeout: ++counters_.timeouts; break;
     case hal::ErrorCode::kCorruptData: ++counters_.corrupt; break;
@@ -161,15 +177,19 @@ hal::Result<hal::TensionSample> ModbusLoadCell::read() {
       last = connect();
       if (!last.ok()) continue;
     }
-    std::uint16_t registers[kTensionRegisterCount] = {};
+    std::uint16_t registers[kMaxSpanRegisters] = {};
+    const unsigned long long exceptions_before = counters_.exceptions;
     last = try_read(registers);
     if (last.ok()) {
-      const hal::Result<TensionRegisters> decoded = decode_tension_registers(registers, config_.word_order);
+      const hal::Result<LoadCellReading> decoded = decode_load_cell(config_.map, registers);
       if (!decoded.ok()) {
         return hal::Status(decoded.status().code(), config_.endpoint + ": " + decoded.status().message());
       }
       return hal::TensionSample{decoded.value().tension_n, decoded.value().stable, clock_.now_us()};
     }
+    // An exception is the device's considered answer (no such register,
+    // function not supported): asking again gets the same one.
+    if (counters_.exceptions != exceptions_before) return last;
     // A late reply must not be taken for the next answer. On a serial line
     // flushing drops it. A TCP stream may deliver it after any flush, and
     // then every later request would read its predecessor's reply (libmodbus

@@ -1,22 +1,29 @@
 #pragma once
-// hal::LoadCell on Modbus RTU (serial) or TCP through libmodbus, with the
-// register map of drivers/modbus/tension_registers.h.
+// hal::LoadCell on Modbus RTU (serial) or TCP through libmodbus, with a
+// configurable register map (drivers/modbus/load_cell_map.h).
 //
-// One read() = one "read holding/input registers" request for 3 registers,
-// tried up to 1 + retries times; each try waits at most response_timeout_us.
-// Late replies after a timeout are flushed before the next try. libmodbus
-// errno values are translated at this boundary (modbus_error_status):
-// ETIMEDOUT -> kTimeout, EMBBADCRC/EMBBADDATA -> kCorruptData, Modbus
-// exceptions and malformed replies -> kProtocolError, a dropped TCP
-// connection -> kNotConnected (the next try reconnects once). The final
-// Status names the endpoint, the number of tries and the last cause.
+// One read() = one "read holding/input registers" request covering the
+// value and the status register, tried up to 1 + retries times when the
+// transport failed (timeout, CRC or framing, connection lost); each try
+// waits at most response_timeout_us. A Modbus exception reply is the
+// device's answer and is not retried. Late replies after a timeout are
+// flushed before the next try. libmodbus errno values are translated at this
+// boundary (modbus_error_status): ETIMEDOUT -> kTimeout, EMBBADCRC/EMBBADDATA
+// -> kCorruptData, Modbus exceptions and malformed replies -> kProtocolError,
+// a dropped TCP connection -> kNotConnected (the next try reconnects once).
+// The final Status names the endpoint, the number of tries and the last cause.
 //
-// Not real-time safe (blocks for the bus). One thread at a time. Owns its
+// Unit identifier: RTU 1..247 (0 is broadcast, which no device answers;
+// 248..255 are reserved); TCP 0..247 or 255 (a TCP device addressed directly
+// takes 0 or 255; 248..254 libmodbus 3.1 refuses).
+//
+// Blocks for the bus: the daemon runs it on its own thread
+// (drivers/common/load_cell_reader.h). One thread at a time. Owns its
 // libmodbus context (freed in close()/destructor).
 
 #include <string>
 
-#include "drivers/modbus/tension_registers.h"
+#include "drivers/modbus/load_cell_map.h"
 #include "hal/clock.h"
 #include "hal/load_cell.h"
 
@@ -33,10 +40,9 @@ struct ModbusLoadCellConfig {
   char parity = 'N';       // RTU only: 'N', 'E' or 'O'
   int data_bits = 8;       // RTU only
   int stop_bits = 1;       // RTU only
-  int slave_id = 1;        // 1..247 (TCP: unit identifier)
+  int slave_id = 1;        // unit identifier: RTU 1..247, TCP 0..247 or 255
   RegisterKind register_kind = RegisterKind::kHolding;
-  int first_register = 0;  // address of the tension's first word
-  WordOrder word_order = WordOrder::kHighWordFirst;
+  LoadCellMap map;
   hal::TimeUs response_timeout_us = 200'000;
   int retries = 2;
 };
@@ -64,6 +70,7 @@ class ModbusLoadCell final : public hal::LoadCell {
     unsigned long long requests = 0;  // tries sent
     unsigned long long timeouts = 0;
     unsigned long long corrupt = 0;   // CRC / bad data
+    unsigned long long exceptions = 0;  // Modbus exception replies (not retried)
     unsigned long long other_errors = 0;
     unsigned long long reconnects = 0;
   };
@@ -71,8 +78,8 @@ class ModbusLoadCell final : public hal::LoadCell {
 
  private:
   hal::Status connect();
-  // One request; Ok and `registers` filled, or the translated error.
-  hal::Status try_read(std::uint16_t (&registers)[kTensionRegisterCount]);
+  // One request for the map's span; Ok and `registers` filled, or the translated error.
+  hal::Status try_read(std::uint16_t (&registers)[kMaxSpanRegisters]);
 
   ModbusLoadCellConfig config_;
   const hal::Clock& clock_;

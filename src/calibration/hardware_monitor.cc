@@ -17,6 +17,7 @@ void HardwareMonitor::reset() {
   readings_ = Readings{};
   last_pose_received_us_ = -1;
   load_cell_errors_in_row_ = 0;
+  load_cell_first_error_.clear();
 }
 
 std::string HardwareMonitor::poll(hal::TimeUs now_us) {
@@ -31,9 +32,12 @@ std::string HardwareMonitor::poll(hal::TimeUs now_us) {
   readings_.tension_is_new = false;
   const hal::Result<hal::TensionSample> tension = load_cell_.read();
   if (tension.ok()) {
+    readings_.tension_is_new = !readings_.tension || readings_.tension->time_us != tension.value().time_us;
     readings_.tension = tension.value();
-    readings_.tension_is_new = true;
     load_cell_errors_in_row_ = 0;
+  } else if (!readings_.tension) {
+    // Not heard from yet: preflight's first-contact wait decides, and check() names this cause.
+    load_cell_first_error_ = tension.status().to_string();
   } else if (++load_cell_errors_in_row_ > limits_.max_consecutive_load_cell_errors) {
     return "load cell: " + tension.status().to_string() + " (" + std::to_string(load_cell_errors_in_row_) +
            " failed reads in a row)";
@@ -77,7 +81,9 @@ std::string HardwareMonitor::check(hal::TimeUs now_us, bool drives_enabled) cons
            milliseconds(limits_.pose_stale_us) + ")";
   }
   if (!readings_.pose->valid) return "pose source reports tracking lost";
-  if (!readings_.tension) return "load cell: no reading yet";
+  if (!readings_.tension) {
+    return "load cell: no reading yet" + (load_cell_first_error_.empty() ? "" : " (" + load_cell_first_error_ + ")");
+  }
   const double tension_n = readings_.tension->tension_n;
   if (tension_n < limits_.min_tension_n || tension_n > limits_.max_tension_n) {
     return "tension out of limits: " + significant(tension_n) + " N outside [" + significant(limits_.min_tension_n) +

@@ -6,8 +6,12 @@
 // only; time is passed in.
 //
 // Load-cell errors: the driver has already retried (hal/load_cell.h), so an
-// error is a failed transaction; a few in a row are tolerated (a CRC error on
-// a noisy RS-485 line), `max_consecutive_load_cell_errors` + 1 are a fault.
+// error is a failed transaction or, behind drivers/common/load_cell_reader.h,
+// a cell silent past its fault timeout; a few in a row are tolerated (a CRC
+// error on a noisy RS-485 line), `max_consecutive_load_cell_errors` + 1 are a
+// fault. Errors before the first reading are not counted: preflight waits
+// for first contact, then check() says "no reading yet" with their cause.
+// A reading whose time_us equals the previous one's is not new.
 // Not thread-safe; one instance per run loop.
 
 #include <array>
@@ -67,6 +71,7 @@ class HardwareMonitor {
   Readings readings_;
   hal::TimeUs last_pose_received_us_ = -1;
   int load_cell_errors_in_row_ = 0;
+  std::string load_cell_first_error_;  // the latest error before the first reading
 };
 
 }  // namespace cdpr::calibration

@@ -1,6 +1,7 @@
 #include "src/daemon/daemon_config.h"
 
 #include <cmath>
+#include <optional>
 
 #include "src/formats/text_file.h"
 #include "src/formats/toml_reader.h"
@@ -125,26 +126,78 @@ void read_winches(TomlReader& reader, ConfigReader& r, const toml::table& root, 
   }
 }
 
+// The register map: a preset, then any key beside it overrides its value.
+void read_load_cell_map(ConfigReader& r, const toml::table& t, LoadCellConfig& out) {
+  const char* p = "load_cell";
+  std::string preset;
+  r.string(t, "preset", p, preset);
+  if (!preset.empty()) {
+    const std::optional<LoadCellMapConfig> map = load_cell_preset(preset);
+    if (map) {
+      out.preset = preset;
+      out.map = *map;
+    } else {
+      std::string names;
+      for (const std::string_view name : load_cell_preset_names()) names += (names.empty() ? "\"" : ", \"") + std::string(name) + "\"";
+      r.fail(t, "preset", p, "\"" + preset + "\" is not one of " + names);
+    }
+  }
+  LoadCellMapConfig& m = out.map;
+  r.integer(t, "value_address", p, m.value_address, 0, 65535);
+  if (const int type = r.choice(t, "value_type", p, {"float32", "int32", "uint32", "int16", "uint16"}); type >= 0) {
+    r.string(t, "value_type", p, m.value_type);
+  }
+  if (const int order = r.choice(t, "byte_order", p, {"ABCD", "CDAB", "BADC", "DCBA"}); order >= 0) {
+    r.string(t, "byte_order", p, m.byte_order);
+  }
+  r.integer(t, "decimals", p, m.decimals, 0, 9);
+  r.number(t, "scale", p, m.scale, Bound::kAny);
+  if (m.scale == 0.0) r.fail(t, "scale", p, "must not be 0");
+  if (const int unit = r.choice(t, "unit", p, {"N", "kg", "lbf"}); unit >= 0) r.string(t, "unit", p, m.unit);
+  r.integer(t, "status_address", p, m.status_address, -1, 65535);
+  r.integer(t, "stable_mask", p, m.stable_mask, 0, 0xFFFF);
+  if (const int when = r.choice(t, "stable_when", p, {"set", "clear"}); when >= 0) m.stable_when_set = when == 0;
+  r.integer(t, "error_mask", p, m.error_mask, 0, 0xFFFF);
+  if (const int when = r.choice(t, "error_when", p, {"set", "clear"}); when >= 0) m.error_when_set = when == 0;
+  r.integer(t, "sign_mask", p, m.sign_mask, 0, 0xFFFF);
+  if (m.status_address >= 0 && m.status_address >= m.value_address &&
+      m.status_address < m.value_address + (m.value_type.ends_with("16") ? 1 : 2)) {
+    r.fail(t, "status_address", p, "overlaps the value's registers");
+  }
+}
+
 void read_load_cell(TomlReader& reader, ConfigReader& r, const toml::table& root, LoadCellConfig& out) {
   const toml::table& t = reader.table(root, "load_cell", "", kOptional);
   const char* p = "load_cell";
   reader.check_keys(t, p, {{"endpoint", kOptional}, {"baud", kOptional}, {"parity", kOptional},
                            {"data_bits", kOptional}, {"stop_bits", kOptional}, {"slave_id", kOptional},
-                           {"register_kind", kOptional}, {"first_register", kOptional}, {"word_order", kOptional},
-                           {"response_timeout_ms", kOptional}, {"retries", kOptional}});
+                           {"register_kind", kOptional}, {"preset", kOptional}, {"value_address", kOptional},
+                           {"value_type", kOptional}, {"byte_order", kOptional}, {"decimals", kOptional},
+                           {"scale", kOptional}, {"unit", kOptional}, {"status_address", kOptional},
+                           {"stable_mask", kOptional}, {"stable_when", kOptional}, {"error_mask", kOptional},
+                           {"error_when", kOptional}, {"sign_mask", kOptional},
+                           {"response_timeout_ms", kOptional}, {"retries", kOptional},
+                           {"poll_interval_ms", kOptional}, {"fault_timeout_ms", kOptional}});
   r.string(t, "endpoint", p, out.endpoint);
   r.integer(t, "baud", p, out.baud, 300, 4'000'000);
   if (const int parity = r.choice(t, "parity", p, {"N", "E", "O"}); parity >= 0) out.parity = "NEO"[parity];
   r.integer(t, "data_bits", p, out.data_bits, 5, 8);
   r.integer(t, "stop_bits", p, out.stop_bits, 1, 2);
-  r.integer(t, "slave_id", p, out.slave_id, 1, 247);
-  if (const int kind = r.choice(t, "register_kind", p, {"holding", "input"}); kind >= 0) out.input_registers = kind;
-  r.integer(t, "first_register", p, out.first_register, 0, 65533);
-  if (const int order = r.choice(t, "word_order", p, {"high_word_first", "low_word_first"}); order >= 0) {
-    out.low_word_first = order == 1;
+  // Unit identifiers per transport: on a serial line 0 is broadcast (nobody
+  // answers) and 248-255 are reserved; a Modbus TCP device addressed
+  // directly takes 0 or 255 (libmodbus 3.1 refuses 248-254).
+  if (out.endpoint.starts_with("rtu:")) {
+    r.integer(t, "slave_id", p, out.slave_id, 1, 247);
+  } else {
+    r.integer(t, "slave_id", p, out.slave_id, 0, 255);
+    if (out.slave_id > 247 && out.slave_id < 255) r.fail(t, "slave_id", p, "on TCP must be 0..247 or 255");
   }
+  if (const int kind = r.choice(t, "register_kind", p, {"holding", "input"}); kind >= 0) out.input_registers = kind;
+  read_load_cell_map(r, t, out);
   r.duration_us(t, "response_timeout_ms", p, out.response_timeout_us, 1e3);
   r.integer(t, "retries", p, out.retries, 0, 10);
+  r.duration_us(t, "poll_interval_ms", p, out.poll_interval_us, 1e3);
+  r.duration_us(t, "fault_timeout_ms", p, out.fault_timeout_us, 1e3);
 }
 
 void read_io(TomlReader& reader, ConfigReader& r, const toml::table& root, DaemonConfig& c) {

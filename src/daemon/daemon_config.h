@@ -18,6 +18,7 @@
 #include "hal/clock.h"
 #include "solver/calibrate.h"
 #include "src/calibration/calibration_state_machine.h"
+#include "src/daemon/load_cell_presets.h"
 #include "src/formats/expected.h"
 #include "src/formats/format_error.h"
 #include "src/store/calibration_store.h"
@@ -44,12 +45,14 @@ struct LoadCellConfig {
   char parity = 'N';  // 'N', 'E', 'O'
   int data_bits = 8;
   int stop_bits = 1;
-  int slave_id = 1;
+  int slave_id = 1;                // RTU 1..247; TCP 0..247 or 255
   bool input_registers = false;  // register_kind = "input" (0x04) instead of "holding" (0x03)
-  int first_register = 0;
-  bool low_word_first = false;   // word_order = "low_word_first"
+  std::string preset = "legacy-float32";
+  LoadCellMapConfig map;         // the preset's, with the keys given beside it
   hal::TimeUs response_timeout_us = 200'000;
   int retries = 2;
+  hal::TimeUs poll_interval_us = 20'000;     // the reader thread's read period
+  hal::TimeUs fault_timeout_us = 1'000'000;  // no good reading for this long: a fault
 };
 
 struct PoseConfig {

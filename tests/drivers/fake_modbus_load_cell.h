@@ -1,7 +1,8 @@
 #pragma once
 // A Modbus TCP load cell for loopback tests: a real libmodbus server on
 // 127.0.0.1 at a free port chosen by the kernel, serving the register map of
-// drivers/modbus/tension_registers.h from a thread. It can be muted (reads
+// the load-cell map of drivers/modbus/load_cell_map.h (or registers set
+// one by one) from a thread. It can be muted (reads
 // requests, never answers) to provoke timeouts, or answer one request late. Bounded: stop() shuts the
 // client socket down, so the thread ends even while blocked in a receive.
 
@@ -14,15 +15,16 @@
 #include <chrono>
 #include <mutex>
 #include <thread>
+#include <vector>
 
-#include "drivers/modbus/tension_registers.h"
+#include "drivers/modbus/load_cell_map.h"
 
 namespace cdpr::drivers::modbus::test {
 
 class FakeModbusLoadCell {
  public:
-  // Serves `register_count` holding registers from address 0 (the cell's map at `base`).
-  explicit FakeModbusLoadCell(int base = 0, int register_count = 8) : base_(base) {
+  // Serves `register_count` holding and input registers from address 0.
+  explicit FakeModbusLoadCell(int register_count = 16) {
     context_ = modbus_new_tcp("127.0.0.1", 0);
     mapping_ = modbus_mapping_new(0, 0, register_count, register_count);
     listener_ = modbus_tcp_listen(context_, 1);
@@ -35,13 +37,22 @@ class FakeModbusLoadCell {
   ~FakeModbusLoadCell() { stop(); }
 
   int port() const { return port_; }
-  void set(float tension_n, bool stable, bool error = false, WordOrder order = WordOrder::kHighWordFirst) {
+  // The value the transmitter shows (its unit, before the map's scale) laid out by `map`.
+  void set(double shown_value, bool stable, bool error = false, const LoadCellMap& map = LoadCellMap{}) {
+    const RegisterSpan span = register_span(map);
+    std::uint16_t registers[kMaxSpanRegisters] = {};
+    encode_load_cell(map, shown_value, stable, error, registers);
+    set_registers(span.first, {registers, registers + span.count});
+  }
+  // Raw register values from `address` on (a vendor's layout typed in from its manual).
+  void set_registers(int address, std::initializer_list<std::uint16_t> values) {
+    set_registers(address, std::vector<std::uint16_t>(values));
+  }
+  void set_registers(int address, const std::vector<std::uint16_t>& values) {
     std::lock_guard<std::mutex> lock(mutex_);
-    std::uint16_t registers[kTensionRegisterCount];
-    encode_tension_registers({tension_n, stable, error}, order, registers);
-    for (int i = 0; i < kTensionRegisterCount; ++i) {
-      mapping_->tab_registers[base_ + i] = registers[i];
-      mapping_->tab_input_registers[base_ + i] = registers[i];
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      mapping_->tab_registers[address + i] = values[i];
+      mapping_->tab_input_registers[address + i] = values[i];
     }
   }
   void mute(bool muted) { muted_ = muted; }
@@ -94,7 +105,6 @@ class FakeModbusLoadCell {
     }
   }
 
-  int base_;
   modbus_t* context_ = nullptr;
   modbus_mapping_t* mapping_ = nullptr;
   int listener_ = -1;

@@ -6,7 +6,7 @@
 // (fake_modbus_peer.h). modbus_reply covers the register decoding alone.
 //
 // Input: byte 0 picks the exchange (bit 0: RTU instead of TCP; bit 1: input
-// registers (0x04) instead of holding (0x03); bit 2: low word first; bit 3:
+// registers (0x04) instead of holding (0x03); bit 2: low word first (CDAB); bit 3:
 // the peer repairs the transaction id or CRC), the rest is the reply.
 //
 // Promises: never a crash or a hang beyond the driver's timeout; a refusal
@@ -38,9 +38,10 @@ constexpr std::size_t kMaxReplyBytes = 600;
 constexpr int kSlaveId = 1;
 
 void check_accepted(const std::vector<std::uint8_t>& sent, const std::vector<std::uint8_t>& request, bool rtu,
-                    bool input_registers, WordOrder order, const cdpr::hal::TensionSample& sample) {
+                    bool input_registers, const LoadCellMap& map, const cdpr::hal::TensionSample& sample) {
   const std::size_t function_at = rtu ? 1 : 7;
-  require(sent.size() >= function_at + 2 + 2 * kTensionRegisterCount, "an accepted reply holds a whole frame");
+  const int count = register_span(map).count;
+  require(sent.size() >= function_at + 2 + 2 * static_cast<std::size_t>(count), "an accepted reply holds a whole frame");
   if (rtu) {
     require(sent[0] == kSlaveId, "an accepted RTU reply comes from the addressed slave");
   } else {
@@ -49,22 +50,22 @@ void check_accepted(const std::vector<std::uint8_t>& sent, const std::vector<std
   }
   require(sent[function_at] == (input_registers ? 0x04 : 0x03), "an accepted reply answers the requested function");
   const std::size_t byte_count = sent[function_at + 1];
-  require(byte_count / 2 == kTensionRegisterCount, "an accepted reply carries three registers");
+  require(byte_count / 2 == static_cast<std::size_t>(count), "an accepted reply carries the requested registers");
   if (rtu) {
     const std::size_t end = function_at + 2 + byte_count;
     require(sent.size() >= end + 2, "an accepted RTU reply has its CRC");
     const std::uint16_t crc = cdpr::fakes::modbus_crc16(sent.data(), end);
     require(sent[end] == (crc & 0xFF) && sent[end + 1] == (crc >> 8), "an accepted RTU reply has a correct CRC");
   }
-  std::uint16_t registers[kTensionRegisterCount];
-  for (int i = 0; i < kTensionRegisterCount; ++i) {
+  std::uint16_t registers[kMaxSpanRegisters];
+  for (int i = 0; i < count; ++i) {
     const std::size_t at = function_at + 2 + 2 * static_cast<std::size_t>(i);
     registers[i] = static_cast<std::uint16_t>((sent[at] << 8) | sent[at + 1]);
   }
-  const auto decoded = decode_tension_registers(registers, order);
+  const auto decoded = decode_load_cell(map, registers);
   require(decoded.ok(), "an accepted reading decodes from the frame's registers");
   // Accepted tensions are finite, so == is exact here.
-  require(static_cast<double>(decoded.value().tension_n) == sample.tension_n && decoded.value().stable == sample.stable,
+  require(decoded.value().tension_n == sample.tension_n && decoded.value().stable == sample.stable,
           "an accepted reading is the frame's registers");
 }
 
@@ -74,7 +75,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size == 0) return 0;
   const bool rtu = (data[0] & 1) != 0;
   const bool input_registers = (data[0] & 2) != 0;
-  const WordOrder order = (data[0] & 4) != 0 ? WordOrder::kLowWordFirst : WordOrder::kHighWordFirst;
+  LoadCellMap map;  // float32 newtons at 0-1, status at 2
+  map.byte_order = (data[0] & 4) != 0 ? ByteOrder::kCDAB : ByteOrder::kABCD;
   const bool repair = (data[0] & 8) != 0;
   std::vector<std::uint8_t> reply(data + 1, data + 1 + std::min(size - 1, kMaxReplyBytes));
 
@@ -89,7 +91,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   config.endpoint = endpoint;
   config.slave_id = kSlaveId;
   config.register_kind = input_registers ? RegisterKind::kInput : RegisterKind::kHolding;
-  config.word_order = order;
+  config.map = map;
   // The peer answers at once; a frame cut short waits this long (RTU; TCP
   // sees the end of the stream).
   config.response_timeout_us = 5'000;
@@ -107,6 +109,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             "a refused reply names the endpoint and a reason");
     return 0;
   }
-  check_accepted(peer.sent_reply(), peer.request(), rtu, input_registers, order, reading.value());
+  check_accepted(peer.sent_reply(), peer.request(), rtu, input_registers, map, reading.value());
   return 0;
 }

@@ -20,7 +20,7 @@
 
 #include "../fakes/manual_clock.h"
 #include "drivers/modbus/modbus_load_cell.h"
-#include "virtual-robot/modbus_server.h"
+#include "virtual-robot/modbus_tcp_server.h"
 
 namespace cdpr::virtual_robot {
 namespace {
@@ -54,10 +54,11 @@ bool closed_by_server(int fd, int wait_ms) {
 TEST(VirtualRobotLoadCell, SlowGreedyOrGarbageClientsNeverStallThePhysicsThread) {
   // GIVEN the load cell served by a loop like the virtual robot's physics
   // thread, which times every service() call
-  auto server = ModbusServer::listen(0, 1, drivers::modbus::WordOrder::kHighWordFirst);
+  VirtualLoadCell device(LoadCellServerOptions{});
+  device.set_reading(702.5, true, false);
+  auto server = ModbusTcpServer::listen(0, device);
   ASSERT_TRUE(server.ok()) << server.status().to_string();
-  ModbusServer& cell = *server.value();
-  cell.set_value({702.5f, true, false});
+  ModbusTcpServer& cell = *server.value();
   std::atomic<bool> stop{false};
   std::atomic<long long> longest_service_us{0};
   std::thread physics([&] {
@@ -67,7 +68,8 @@ TEST(VirtualRobotLoadCell, SlowGreedyOrGarbageClientsNeverStallThePhysicsThread)
       cell.append_poll_fds(fds);
       poll(fds.data(), fds.size(), 2);
       const auto start = std::chrono::steady_clock::now();
-      cell.service(fds);
+      cell.service(fds, std::chrono::duration_cast<std::chrono::microseconds>(
+                            std::chrono::steady_clock::now().time_since_epoch()).count());
       const long long took_us =
           std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - start).count();
       if (took_us > longest_service_us.load()) longest_service_us.store(took_us);

@@ -17,9 +17,12 @@
 #include "calibctl/json_value.h"
 #include "drivers/can/canopen_winch_bank.h"
 #include "drivers/clock/monotonic_clock.h"
+#include "drivers/common/load_cell_reader.h"
 #include "drivers/modbus/modbus_load_cell.h"
 #include "drivers/pose/pose_stream_source.h"
 #include "src/daemon/daemon_loop.h"
+#include "src/daemon/load_cell_presets.h"
+#include "src/load_cell_driver_config.h"
 #include "virtual-robot/virtual_robot.h"
 
 namespace cdpr::integration {
@@ -41,6 +44,13 @@ inline daemon::DaemonConfig fast_daemon_config(const std::string& dir, const vir
   config.control_socket = dir + "/control";
   config.winches.endpoint = robot.can_endpoint();
   config.load_cell.endpoint = robot.modbus_endpoint();
+  // The virtual cell's register map, as an operator would configure it: the
+  // vendor's preset and the indicator's decimal point.
+  const virtual_robot::LoadCellModel model = robot.options().load_cell.model;
+  config.load_cell.preset = virtual_robot::to_string(model);
+  config.load_cell.map = *daemon::load_cell_preset(config.load_cell.preset);
+  if (model != virtual_robot::LoadCellModel::kLegacyFloat32) config.load_cell.map.decimals = virtual_robot::kShownDecimals;
+  config.load_cell.slave_id = robot.options().load_cell.unit_id;
   config.pose.endpoint = robot.pose_endpoint();
   config.button.gpio = false;
   config.calibrator.settle_timeout_us = 15'000'000;
@@ -103,14 +113,17 @@ class VirtualRobotRig {
     }
     winches = std::make_unique<drivers::can::CanopenWinchBank>(
         winch_config, drivers::can::make_can_connector(config.winches.endpoint));
-    drivers::modbus::ModbusLoadCellConfig cell_config;
-    cell_config.endpoint = config.load_cell.endpoint;
-    load_cell = std::make_unique<drivers::modbus::ModbusLoadCell>(cell_config, clock);
+    load_cell = std::make_unique<drivers::modbus::ModbusLoadCell>(daemon::load_cell_driver_config(config.load_cell),
+                                                                  clock);
+    load_cell_reader = std::make_unique<drivers::LoadCellReader>(
+        *load_cell, clock,
+        drivers::LoadCellReaderOptions{config.load_cell.poll_interval_us, config.load_cell.fault_timeout_us,
+                                       daemon::DaemonLoop::kReconnectIntervalUs});
     pose = std::make_unique<drivers::pose::PoseStreamSource>(config.pose.endpoint, clock);
     store = std::make_unique<store::CalibrationStore>(config.store);
     EXPECT_TRUE(store->open());
     loop = std::make_unique<daemon::DaemonLoop>(config, robot->nominal_robot(),
-                                                daemon::DaemonDevices{*winches, *load_cell, *pose, nullptr}, *store,
+                                                daemon::DaemonDevices{*winches, *load_cell_reader, *pose, nullptr}, *store,
                                                 clock, notifier, nullptr);
     const hal::Status started = loop->start();
     EXPECT_TRUE(started.ok()) << started.to_string();
@@ -154,6 +167,7 @@ class VirtualRobotRig {
   drivers::MonotonicClock clock;
   std::unique_ptr<drivers::can::CanopenWinchBank> winches;
   std::unique_ptr<drivers::modbus::ModbusLoadCell> load_cell;
+  std::unique_ptr<drivers::LoadCellReader> load_cell_reader;  // what the daemon reads, as in main()
   std::unique_ptr<drivers::pose::PoseStreamSource> pose;
   std::unique_ptr<store::CalibrationStore> store;
   NullNotifier notifier;

@@ -20,7 +20,7 @@ void on_signal(int) { g_stop.store(true); }
 int main(int argc, char** argv) {
   using cdpr::virtual_robot::VirtualRobotOptions;
   CLI::App app{"virtual-robot: a simulated cable robot (true heavy-cable equilibrium, first-order settling, "
-               "sensor noise of the preset) serving CANopen over a Unix socket, a Modbus TCP load cell and a "
+               "sensor noise of the preset) serving CANopen over a Unix socket, a Modbus TCP or RTU load cell and a "
                "pose stream; writes robot.toml (nominal), truth.toml and 'ready' into --endpoints"};
   VirtualRobotOptions options;
   std::string preset = "large";
@@ -34,6 +34,21 @@ int main(int argc, char** argv) {
                  "directory for can.sock, pose.sock, robot.toml, truth.toml and ready (created)")->required();
   app.add_option("--modbus-port", options.modbus_port, "Modbus TCP port on 127.0.0.1; 0: any free port (see ready)")
       ->check(CLI::Range(0, 65535))->capture_default_str();
+  std::string transport = "tcp";
+  app.add_option("--modbus-transport", transport,
+                 "load cell on Modbus TCP (127.0.0.1:--modbus-port) or RTU (a pty linked as <endpoints>/load_cell.tty)")
+      ->check(CLI::IsMember({"tcp", "rtu"}))->capture_default_str();
+  std::string model = "legacy-float32";
+  app.add_option("--load-cell-model", model,
+                 "register map: legacy-float32 (float32 N), flintec-ft-11 or laumas-tlu (kg, 2 decimals; "
+                 "docs/fieldbus.md)")
+      ->check(CLI::IsMember({"legacy-float32", "flintec-ft-11", "laumas-tlu"}))->capture_default_str();
+  app.add_option("--modbus-unit-id", options.load_cell.unit_id,
+                 "the load cell's unit identifier; requests for others get no answer (RTU) or exception 0x0B (TCP)")
+      ->check(CLI::Range(1, 247))->capture_default_str();
+  double latency_ms = 0.0;
+  app.add_option("--modbus-latency-ms", latency_ms, "reply latency of the load cell [ms, real time]")
+      ->check(CLI::Range(0.0, 10'000.0))->capture_default_str();
   app.add_option("--anchor-perturbation", options.anchor_perturbation_m,
                  "robot.toml's nominal anchors = true anchors + a random vector of this norm [m]")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
@@ -47,6 +62,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1.0, 1000.0))->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   options.preset = *cdpr::sim::parse_preset(preset);
+  options.modbus_rtu = transport == "rtu";
+  options.load_cell.model = *cdpr::virtual_robot::parse_load_cell_model(model);
+  options.load_cell.reply_latency_us = static_cast<cdpr::hal::TimeUs>(latency_ms * 1000.0);
 
   std::error_code error;
   std::filesystem::create_directories(options.dir, error);

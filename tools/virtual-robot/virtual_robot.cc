@@ -8,6 +8,8 @@
 #include "drivers/can/fd_can_transport.h"
 #include "drivers/pose/pose_line.h"
 #include "sim/stream_purpose.h"
+#include "virtual-robot/modbus_rtu_server.h"
+#include "virtual-robot/modbus_tcp_server.h"
 #include "solver/pose.h"
 #include "src/formats/calibration_toml.h"
 #include "src/formats/robot_toml.h"
@@ -69,15 +71,24 @@ Expected<std::unique_ptr<VirtualRobot>, std::string> VirtualRobot::create(const 
   auto pose = StreamListener::listen(options.dir + "/pose.sock");
   if (!pose.ok()) return Unexpected{"pose socket: " + pose.status().to_string()};
   robot->pose_ = std::move(pose.value());
-  auto modbus = ModbusServer::listen(options.modbus_port, options.modbus_slave_id,
-                                     drivers::modbus::WordOrder::kHighWordFirst);
-  if (!modbus.ok()) return Unexpected{"load cell: " + modbus.status().to_string()};
-  robot->modbus_ = std::move(modbus.value());
+  robot->cell_ = std::make_unique<VirtualLoadCell>(options.load_cell);
+  std::string ready = "modbus_endpoint = \"";
+  if (options.modbus_rtu) {
+    auto rtu = ModbusRtuServer::open(options.dir + "/load_cell.tty", *robot->cell_);
+    if (!rtu.ok()) return Unexpected{"load cell: " + rtu.status().to_string()};
+    robot->modbus_ = std::move(rtu.value());
+    ready += robot->modbus_->endpoint() + "\"\n";
+  } else {
+    auto tcp = ModbusTcpServer::listen(options.modbus_port, *robot->cell_);
+    if (!tcp.ok()) return Unexpected{"load cell: " + tcp.status().to_string()};
+    ready += tcp.value()->endpoint() + "\"\nmodbus_port = " + std::to_string(tcp.value()->port()) + "\n";
+    robot->modbus_ = std::move(tcp.value());
+  }
   robot->publish(now_us);
 
   if (!write_file(options.dir + "/robot.toml", formats::format_robot_toml(robot->data_.nominal)) ||
       !write_file(options.dir + "/truth.toml", formats::format_truth_toml(robot->data_.truth)) ||
-      !write_file(options.dir + "/ready", "modbus_port = " + std::to_string(robot->modbus_->port()) + "\n")) {
+      !write_file(options.dir + "/ready", ready)) {
     return Unexpected{"cannot write robot.toml, truth.toml or ready in " + options.dir};
   }
   return robot;
@@ -91,17 +102,18 @@ void VirtualRobot::run(const std::atomic<bool>& stop) {
 }
 
 void VirtualRobot::run_once(hal::TimeUs max_wait_us) {
+  follow_pose_fault();
   fds_.clear();
   can_->append_poll_fds(fds_);
-  pose_->append_poll_fds(fds_);
+  if (pose_) pose_->append_poll_fds(fds_);
   modbus_->append_poll_fds(fds_);
   const int ready = poll(fds_.data(), fds_.size(), static_cast<int>(max_wait_us / 1000));
   if (ready > 0) {
     can_->service(fds_, [this](int client, std::string_view bytes) { on_can_bytes(client, bytes); });
-    pose_->service(fds_, [](int, std::string_view) {});  // the pose stream is one-way
-    modbus_->service(fds_);
+    if (pose_) pose_->service(fds_, [](int, std::string_view) {});  // the pose stream is one-way
   }
   const hal::TimeUs now_us = clock_.now_us();
+  modbus_->service(fds_, now_us);  // also sends replies whose latency has passed
   physics_->advance(options_.time_scale * 1e-6 * static_cast<double>(now_us - last_us_));
   last_us_ = now_us;
   publish(now_us);
@@ -137,14 +149,27 @@ void VirtualRobot::publish(hal::TimeUs now_us) {
   const int reference = robot.reference_cable;
   bool winches_still = true;
   for (int i = 0; i < kCableCount; ++i) winches_still = winches_still && physics_->at_target(i);
-  drivers::modbus::TensionRegisters cell;
-  cell.tension_n = static_cast<float>(physics_->tension_n(reference) + k * robot.noise.force_n * noise_.normal());
-  cell.stable = winches_still && physics_->tension_unsettled_n(reference) < std::max(1.0, robot.noise.force_n);
-  modbus_->set_value(cell);
+  cell_->set_reading(physics_->tension_n(reference) + k * robot.noise.force_n * noise_.normal(),
+                     winches_still && physics_->tension_unsettled_n(reference) < std::max(1.0, robot.noise.force_n),
+                     false);
+  publish_pose(now_us);
+}
 
+void VirtualRobot::follow_pose_fault() {
+  const bool disconnected = pose_fault_.load() == DeviceFault::kDisconnected;
+  if (disconnected && pose_) pose_.reset();  // closes every client, removes the socket
+  if (!disconnected && !pose_) {
+    auto pose = StreamListener::listen(options_.dir + "/pose.sock");
+    if (pose.ok()) pose_ = std::move(pose.value());
+  }
+}
+
+void VirtualRobot::publish_pose(hal::TimeUs now_us) {
   if (now_us < next_pose_us_) return;
   next_pose_us_ += static_cast<hal::TimeUs>(1e6 / options_.pose_rate_hz);
   if (next_pose_us_ < now_us) next_pose_us_ = now_us;  // after a stall: no burst of old poses
+  const Robot& robot = data_.true_robot.robot;
+  const double k = options_.noise_scale;
   const Pose& truth = physics_->pose();
   const Eigen::Vector3d position =
       truth.position_world + k * robot.noise.position_m * Eigen::Vector3d(noise_.normal(), noise_.normal(), noise_.normal());
@@ -156,7 +181,10 @@ void VirtualRobot::publish(hal::TimeUs now_us) {
   sample.world_R_platform = {rotation.w(), rotation.x(), rotation.y(), rotation.z()};
   sample.valid = true;
   sample.source_time_us = start_us_ + static_cast<hal::TimeUs>(options_.time_scale * static_cast<double>(now_us - start_us_));
-  pose_->broadcast(drivers::pose::format_pose_line(sample));
+  const DeviceFault fault = pose_fault_.load();
+  if (!pose_ || fault == DeviceFault::kSilent) return;
+  pose_->broadcast(fault == DeviceFault::kGarbage ? std::string("\x01\x02 not a pose %%\n")
+                                                  : drivers::pose::format_pose_line(sample));
 }
 
 }  // namespace cdpr::virtual_robot

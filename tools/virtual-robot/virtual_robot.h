@@ -6,12 +6,14 @@
 //   <dir>/can.sock    CAN frames over a Unix stream socket (the record format
 //                     of drivers/can/fd_can_transport.h): 4 CiA 402 drives and
 //                     4 CiA 406 encoders (canopen_nodes.h)
-//   127.0.0.1:<port>  Modbus TCP load cell on the reference cable
-//                     (drivers/modbus/tension_registers.h at address 0)
+//   127.0.0.1:<port>  Modbus TCP load cell on the reference cable, or with
+//   <dir>/load_cell.tty  modbus_transport "rtu" a Modbus RTU one on a pty;
+//                     register map per load_cell_model (load_cell_models.h)
 //   <dir>/pose.sock   pose stream (drivers/pose/pose_line.h) at pose_rate_hz
 //   <dir>/robot.toml  the NOMINAL robot (anchors perturbed), for the daemon
 //   <dir>/truth.toml  the truth (anchors, encoder offsets), for comparison
-//   <dir>/ready       "modbus_port = <port>", written once everything listens
+//   <dir>/ready       "modbus_endpoint = <endpoint>" and, on TCP,
+//                     "modbus_port = <port>", written once everything listens
 //
 // Physics (robot_physics.h) from the simulator's true equilibrium; sensor
 // noise per the preset (robot.toml [noise]) on every single reading.
@@ -33,7 +35,8 @@
 #include "sim/rng.h"
 #include "src/formats/expected.h"
 #include "virtual-robot/canopen_nodes.h"
-#include "virtual-robot/modbus_server.h"
+#include "virtual-robot/modbus_transport.h"
+#include "virtual-robot/virtual_load_cell.h"
 #include "virtual-robot/robot_physics.h"
 #include "virtual-robot/stream_listener.h"
 
@@ -46,8 +49,9 @@ struct VirtualRobotOptions {
   double anchor_perturbation_m = 1.0; // nominal anchors of robot.toml = truth + this [m]
   double noise_scale = 1.0;           // multiplies every sensor sigma
   std::string dir;                    // sockets and files (must exist)
-  int modbus_port = 0;                // 0: any free port
-  int modbus_slave_id = 1;
+  bool modbus_rtu = false;            // RTU on <dir>/load_cell.tty instead of TCP
+  int modbus_port = 0;                // TCP; 0: any free port
+  LoadCellServerOptions load_cell;    // register map, unit id, reply latency
   double pose_rate_hz = 100.0;
   PhysicsOptions physics;
   NodeLayout nodes;                   // encoder noise is set from the preset
@@ -73,17 +77,24 @@ class VirtualRobot {
 
   std::string can_endpoint() const { return "unix:" + options_.dir + "/can.sock"; }
   std::string pose_endpoint() const { return "unix:" + options_.dir + "/pose.sock"; }
-  std::string modbus_endpoint() const { return "tcp:127.0.0.1:" + std::to_string(modbus_->port()); }
+  std::string modbus_endpoint() const { return modbus_->endpoint(); }
+  const VirtualRobotOptions& options() const { return options_; }
   const Robot& nominal_robot() const { return data_.nominal; }
   const Truth& truth() const { return data_.truth; }
   const RobotPhysics& physics() const { return *physics_; }
   CanopenNodes& nodes() { return *nodes_; }
-  ModbusServer& load_cell() { return *modbus_; }
+  VirtualLoadCell& load_cell() { return *cell_; }
+  // The pose stream's fault (any thread): kSilent stops sending, kGarbage
+  // sends lines that are not poses, kDisconnected closes the socket.
+  void set_pose_fault(DeviceFault fault) { pose_fault_.store(fault); }
 
  private:
   VirtualRobot(const VirtualRobotOptions& options, sim::SimulatedDataset data);
   void publish(hal::TimeUs now_us);
   void on_can_bytes(int client, std::string_view bytes);
+  void publish_pose(hal::TimeUs now_us);
+  // Closes or reopens the pose socket as pose_fault_ says.
+  void follow_pose_fault();
 
   VirtualRobotOptions options_;
   sim::SimulatedDataset data_;
@@ -93,7 +104,9 @@ class VirtualRobot {
   std::unique_ptr<CanopenNodes> nodes_;
   std::unique_ptr<StreamListener> can_;
   std::unique_ptr<StreamListener> pose_;
-  std::unique_ptr<ModbusServer> modbus_;
+  std::unique_ptr<VirtualLoadCell> cell_;
+  std::unique_ptr<ModbusTransport> modbus_;
+  std::atomic<DeviceFault> pose_fault_{DeviceFault::kNone};
   std::map<int, std::string> can_partial_;  // per CAN client: bytes of an incomplete record
   hal::TimeUs last_us_ = 0;
   hal::TimeUs start_us_ = 0;

@@ -63,7 +63,10 @@ endpoint = "unix:/tmp/can.sock"
 [load_cell]
 endpoint = "tcp:127.0.0.1:1502"
 parity = "E"
-word_order = "low_word_first"
+preset = "flintec-ft-11"
+decimals = 1
+byte_order = "CDAB"
+fault_timeout_ms = 400
 [button]
 kind = "none"
 [equilibrium]
@@ -83,7 +86,15 @@ accept_max_iterations = true
   EXPECT_EQ(config->loop_period_us, 10'000);
   EXPECT_EQ(config->winches.endpoint, "unix:/tmp/can.sock");
   EXPECT_EQ(config->load_cell.parity, 'E');
-  EXPECT_TRUE(config->load_cell.low_word_first);
+  // the preset's map, with the keys beside it overriding
+  EXPECT_EQ(config->load_cell.preset, "flintec-ft-11");
+  EXPECT_EQ(config->load_cell.map.value_type, "int32");
+  EXPECT_EQ(config->load_cell.map.byte_order, "CDAB");
+  EXPECT_EQ(config->load_cell.map.decimals, 1);
+  EXPECT_EQ(config->load_cell.map.unit, "kg");
+  EXPECT_EQ(config->load_cell.map.error_mask, 0x0002);
+  EXPECT_FALSE(config->load_cell.map.error_when_set);
+  EXPECT_EQ(config->load_cell.fault_timeout_us, 400'000);
   EXPECT_FALSE(config->button.gpio);
   EXPECT_EQ(config->calibrator.equilibrium.window_us, 1'500'000);
   EXPECT_EQ(config->calibrator.planner.selection, calibration::WaypointSelection::kInformative);
@@ -100,6 +111,11 @@ TEST(DaemonConfig, RefusesBadInputNamingLineAndKey) {
   const Case cases[] = {
       {"robot = \"r\"\n[loop]\nperiod_msec = 10\n", 3, "loop.period_msec"},               // unknown key
       {"robot = \"r\"\n[load_cell]\nslave_id = 300\n", 3, "load_cell.slave_id"},          // out of range
+      {"robot = \"r\"\n[load_cell]\nslave_id = 0\n", 3, "load_cell.slave_id"},            // broadcast on RTU
+      {"robot = \"r\"\n[load_cell]\nendpoint = \"tcp:h:502\"\nslave_id = 250\n", 4, "load_cell.slave_id"},
+      {"robot = \"r\"\n[load_cell]\npreset = \"ft11\"\n", 3, "load_cell.preset"},         // unknown preset
+      {"robot = \"r\"\n[load_cell]\nbyte_order = \"ADCB\"\n", 3, "load_cell.byte_order"},
+      {"robot = \"r\"\n[load_cell]\nstatus_address = 1\n", 3, "load_cell.status_address"},  // overlaps the value
       {"robot = \"r\"\n[button]\nkind = \"gpoi\"\n", 3, "button.kind"},                    // not a choice
       {"robot = \"r\"\n[waypoints]\nselection = \"optimal\"\n", 3, "waypoints.selection"},  // not a choice
       {"robot = \"r\"\n[loop]\nperiod_ms = -5\n", 3, "loop.period_ms"},                    // not positive

@@ -1,0 +1,61 @@
+#include "src/daemon/load_cell_presets.h"
+
+namespace cdpr::daemon {
+namespace {
+
+// The map this daemon always read (and the virtual robot's default):
+// float32 newtons at 0-1, status at 2 with bit 0 stable and bit 1 error.
+LoadCellMapConfig legacy_float32() { return LoadCellMapConfig{}; }
+
+// Flintec FT-11 indicator, Modbus RTU appendix: the displayed weight as a
+// 32-bit integer at 40001-40002 (high word first), status at 40003 with
+// D1 "data ok" (0: error, code in D13-D15) and D2 "motion" (1: not stable).
+// The decimal point and unit are the indicator's settings (kg by default).
+LoadCellMapConfig flintec_ft11() {
+  LoadCellMapConfig m;
+  m.value_address = 0;
+  m.value_type = "int32";
+  m.unit = "kg";
+  m.status_address = 2;
+  m.stable_mask = 0x0004;
+  m.stable_when_set = false;
+  m.error_mask = 0x0002;
+  m.error_when_set = false;
+  return m;
+}
+
+// Laumas TLU transmitter: status register 40007, gross weight 40008 (high)
+// and 40009 (low) as a positive integer without decimal point, its sign in
+// status bit 7. Status bits 0-4 (load cell error, A/D converter
+// malfunction, maximum weight exceeded by 9 divisions, gross above 110 % of
+// full scale, gross beyond +-999999) make the reading unusable; bit 11 is
+// "weight stability".
+LoadCellMapConfig laumas_tlu() {
+  LoadCellMapConfig m;
+  m.value_address = 7;
+  m.value_type = "uint32";
+  m.unit = "kg";
+  m.status_address = 6;
+  m.stable_mask = 0x0800;
+  m.stable_when_set = true;
+  m.error_mask = 0x001F;
+  m.error_when_set = true;
+  m.sign_mask = 0x0080;
+  return m;
+}
+
+}  // namespace
+
+const std::vector<std::string_view>& load_cell_preset_names() {
+  static const std::vector<std::string_view> names = {"legacy-float32", "flintec-ft-11", "laumas-tlu"};
+  return names;
+}
+
+std::optional<LoadCellMapConfig> load_cell_preset(std::string_view name) {
+  if (name == "legacy-float32") return legacy_float32();
+  if (name == "flintec-ft-11") return flintec_ft11();
+  if (name == "laumas-tlu") return laumas_tlu();
+  return std::nullopt;
+}
+
+}  // namespace cdpr::daemon
