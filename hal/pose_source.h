@@ -40,7 +40,9 @@ class PoseSource {
  public:
   virtual ~PoseSource() = default;
 
-  // Connects to the stream. Errors: kNotConnected, kInvalidArgument (bad config).
+  // Connects to the stream, or only starts connecting (a driver that must not
+  // wait): update() then reports kNotConnected if the connect fails. Errors:
+  // kNotConnected, kInvalidArgument (bad config).
   virtual Status open() = 0;
   // Releases the connection; safe to call twice or without open().
   virtual void close() = 0;

@@ -99,7 +99,7 @@ hal::Result<hal::TensionSample> LoadCellReader::read() {
     return hal::Status(hal::ErrorCode::kTimeout,
                        "load cell: no reading yet" + (last_failure_.ok() ? std::string() : " (" + last_failure_.to_string() + ")"));
   }
-  const std::string cause = last_failure_.ok() ? "no transaction completed" : last_failure_.message();
+  const std::string cause = last_failure_.ok() ? "no answer yet to the request in flight" : last_failure_.message();
   return hal::Status(last_failure_.ok() ? hal::ErrorCode::kTimeout : last_failure_.code(),
                      cause + "; no good reading for " + milliseconds(silent_us) + " (limit " +
                          milliseconds(options_.fault_timeout_us) + ")");

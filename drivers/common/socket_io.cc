@@ -121,4 +121,65 @@ hal::Result<int> connect_endpoint(std::string_view endpoint, hal::TimeUs timeout
                      "endpoint '" + std::string(endpoint) + "': expected unix:<path> or tcp:<host>:<port>");
 }
 
+hal::Result<int> start_connect_endpoint(std::string_view endpoint) {
+  const std::string device(endpoint);
+  if (endpoint.starts_with("unix:")) {
+    const std::string path(endpoint.substr(5));
+    sockaddr_un address{};
+    address.sun_family = AF_UNIX;
+    if (path.empty() || path.size() >= sizeof(address.sun_path)) {
+      return hal::Status(hal::ErrorCode::kInvalidArgument, "unix socket path empty or too long: '" + path + "'");
+    }
+    std::memcpy(address.sun_path, path.data(), path.size());
+    const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
+    if (fd < 0) return status_from_errno(errno, device, "socket");
+    if (::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) != 0) {
+      const int error_number = errno;
+      ::close(fd);
+      return status_from_errno(error_number, device, "connect");
+    }
+    return fd;
+  }
+  const std::string_view rest = endpoint.starts_with("tcp:") ? endpoint.substr(4) : std::string_view();
+  const std::size_t colon = rest.rfind(':');
+  if (rest.empty() || colon == std::string_view::npos || colon == 0 || colon + 1 == rest.size()) {
+    return hal::Status(hal::ErrorCode::kInvalidArgument,
+                       "endpoint '" + device + "': expected unix:<path> or tcp:<host>:<port>");
+  }
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  hints.ai_flags = AI_NUMERICSERV;
+  addrinfo* found = nullptr;
+  const std::string host(rest.substr(0, colon));
+  const std::string service(rest.substr(colon + 1));
+  if (const int rc = ::getaddrinfo(host.c_str(), service.c_str(), &hints, &found); rc != 0) {
+    return hal::Status(hal::ErrorCode::kNotConnected, device + ": resolve: " + ::gai_strerror(rc));
+  }
+  const int fd = ::socket(found->ai_family, found->ai_socktype | SOCK_CLOEXEC | SOCK_NONBLOCK, found->ai_protocol);
+  if (fd < 0) {
+    ::freeaddrinfo(found);
+    return status_from_errno(errno, device, "socket");
+  }
+  const int rc = ::connect(fd, found->ai_addr, found->ai_addrlen);
+  const int error_number = errno;
+  ::freeaddrinfo(found);
+  if (rc != 0 && error_number != EINPROGRESS) {
+    ::close(fd);
+    return status_from_errno(error_number, device, "connect");
+  }
+  return fd;
+}
+
+hal::Result<bool> connect_progress(int fd, const std::string& device) {
+  const hal::Result<bool> writable = wait_writable(fd, 0);
+  if (!writable.ok()) return writable.status();
+  if (!writable.value()) return false;
+  int so_error = 0;
+  socklen_t length = sizeof(so_error);
+  if (::getsockopt(fd, SOL_SOCKET, SO_ERROR, &so_error, &length) != 0) return status_from_errno(errno, device, "connect");
+  if (so_error != 0) return status_from_errno(so_error, device, "connect");
+  return true;
+}
+
 }  // namespace cdpr::drivers

@@ -22,6 +22,16 @@ hal::Result<int> connect_tcp(const std::string& host, int port, hal::TimeUs time
 // "unix:/run/x.sock" or "tcp:host:port" -> a connected fd (see above).
 hal::Result<int> connect_endpoint(std::string_view endpoint, hal::TimeUs timeout_us);
 
+// Starts connecting to "unix:<path>" or "tcp:<host>:<port>" without waiting:
+// the fd returned may still be connecting (see connect_progress). A TCP host
+// name is resolved first (getaddrinfo blocks for DNS: give a numeric address
+// where that matters); the first address is tried. Errors: kNotConnected
+// (refused, unreachable, no listener), kInvalidArgument (bad endpoint).
+hal::Result<int> start_connect_endpoint(std::string_view endpoint);
+// Whether a connect started by start_connect_endpoint has finished, without
+// waiting: true connected, false still in progress; an error when it failed.
+hal::Result<bool> connect_progress(int fd, const std::string& device);
+
 // Waits at most timeout_us until `fd` is readable (or writable). true: ready;
 // false: timed out. Errors: kIoError from poll(). EINTR restarts the wait.
 hal::Result<bool> wait_readable(int fd, hal::TimeUs timeout_us);

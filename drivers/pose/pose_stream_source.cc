@@ -13,8 +13,7 @@ namespace cdpr::drivers::pose {
 
 PoseStreamSource::PoseStreamSource(const std::string& endpoint, const hal::Clock& clock,
                                    hal::TimeUs connect_timeout_us)
-    : PoseStreamSource([endpoint, connect_timeout_us] { return connect_endpoint(endpoint, connect_timeout_us); },
-                       "pose stream " + endpoint, clock) {}
+    : endpoint_(endpoint), connect_timeout_us_(connect_timeout_us), name_("pose stream " + endpoint), clock_(clock) {}
 
 PoseStreamSource::PoseStreamSource(FdConnector connector, std::string name, const hal::Clock& clock)
     : connector_(std::move(connector)), name_(std::move(name)), clock_(clock) {}
@@ -23,10 +22,12 @@ PoseStreamSource::~PoseStreamSource() { close(); }
 
 hal::Status PoseStreamSource::open() {
   close();
-  hal::Result<int> fd = connector_();
+  hal::Result<int> fd = connector_ ? connector_() : start_connect_endpoint(endpoint_);
   if (!fd.ok()) return hal::Status(fd.status().code(), name_ + ": " + fd.status().message());
   fd_ = fd.value();
   set_nonblocking(fd_);
+  connecting_ = !connector_;
+  connect_started_us_ = clock_.now_us();
   fill_ = 0;
   discarding_ = false;
   return hal::Status::Ok();
@@ -35,10 +36,33 @@ hal::Status PoseStreamSource::open() {
 void PoseStreamSource::close() {
   if (fd_ >= 0) ::close(fd_);
   fd_ = -1;
+  connecting_ = false;
+}
+
+hal::Status PoseStreamSource::finish_connect() {
+  const hal::Result<bool> done = connect_progress(fd_, name_);
+  if (done.ok() && done.value()) {
+    connecting_ = false;
+    return hal::Status::Ok();
+  }
+  hal::Status failure;
+  if (!done.ok()) {
+    failure = hal::Status(hal::ErrorCode::kNotConnected, done.status().message());
+  } else if (clock_.now_us() - connect_started_us_ > connect_timeout_us_) {
+    failure = hal::Status(hal::ErrorCode::kNotConnected,
+                          name_ + ": connect not done within " + std::to_string(connect_timeout_us_ / 1000) + " ms");
+  } else {
+    return hal::Status::Ok();  // still connecting
+  }
+  close();
+  return failure;
 }
 
 hal::Status PoseStreamSource::update(hal::TimeUs timeout_us) {
   if (fd_ < 0) return hal::Status(hal::ErrorCode::kInvalidState, name_ + ": not open");
+  if (connecting_) {
+    if (const hal::Status s = finish_connect(); !s.ok() || connecting_) return s;
+  }
   if (timeout_us > 0) {
     const hal::Result<bool> ready = wait_readable(fd_, timeout_us);
     if (!ready.ok()) {

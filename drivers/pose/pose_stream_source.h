@@ -9,6 +9,11 @@
 // the latest. Malformed and over-long lines are counted and dropped, never
 // an error; a peer that closes gives kNotConnected (call open() to
 // reconnect). No allocation after open(). One thread at a time.
+//
+// With an endpoint, open() only starts the connect and update() finishes it
+// (kNotConnected when it fails or takes longer than connect_timeout_us), so
+// neither waits for a slow or unreachable peer. A TCP host name is resolved
+// in open() (use a numeric address where DNS could stall).
 
 #include <array>
 #include <cstddef>
@@ -29,8 +34,8 @@ class PoseStreamSource final : public hal::PoseSource {
  public:
   static constexpr int kMaxReadsPerUpdate = 64;
 
-  // `endpoint`: "unix:<path>" or "tcp:<host>:<port>"; connect waits at most
-  // connect_timeout_us. `clock` must outlive this object.
+  // `endpoint`: "unix:<path>" or "tcp:<host>:<port>"; a connect not done
+  // within connect_timeout_us fails. `clock` must outlive this object.
   PoseStreamSource(const std::string& endpoint, const hal::Clock& clock, hal::TimeUs connect_timeout_us = 1'000'000);
   // Any way to get a connected fd (tests: one end of a socketpair).
   PoseStreamSource(FdConnector connector, std::string name, const hal::Clock& clock);
@@ -48,9 +53,16 @@ class PoseStreamSource final : public hal::PoseSource {
 
  private:
   void consume_lines(hal::TimeUs now_us);
+  // Finishes a connect in progress: Ok when connected or still within its
+  // time (connecting_ tells), else the failure (the fd closed).
+  hal::Status finish_connect();
   void handle_line(std::string_view line, hal::TimeUs now_us);
 
-  FdConnector connector_;
+  FdConnector connector_;  // empty: connect to endpoint_ without waiting
+  std::string endpoint_;
+  hal::TimeUs connect_timeout_us_ = 0;
+  bool connecting_ = false;
+  hal::TimeUs connect_started_us_ = 0;
   std::string name_;
   const hal::Clock& clock_;
   int fd_ = -1;

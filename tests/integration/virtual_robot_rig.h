@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <thread>
@@ -94,7 +95,11 @@ inline virtual_robot::VirtualRobotOptions large_robot_acceptance_options() {
 
 class VirtualRobotRig {
  public:
-  explicit VirtualRobotRig(virtual_robot::VirtualRobotOptions options) {
+  // `before_start` runs once the robot is up, the configuration made and the
+  // store open, before the drivers and the daemon are built from them (to
+  // change the configuration or commit a previous calibration).
+  explicit VirtualRobotRig(virtual_robot::VirtualRobotOptions options,
+                           const std::function<void(VirtualRobotRig&)>& before_start = {}) {
     char pattern[] = "/tmp/cdpr-integration-XXXXXX";
     dir = mkdtemp(pattern);
     options.dir = dir + "/robot";
@@ -106,6 +111,9 @@ class VirtualRobotRig {
 
     config = fast_daemon_config(dir, *robot);
     if (options.preset == sim::Preset::kSmall) use_small_robot_limits(config);
+    store = std::make_unique<store::CalibrationStore>(config.store);
+    EXPECT_TRUE(store->open());
+    if (before_start) before_start(*this);
     drivers::can::CanWinchBankConfig winch_config;
     winch_config.heartbeat_timeout_us = config.winches.heartbeat_timeout_us;
     for (const daemon::WinchNodes& w : config.winches.winches) {
@@ -120,8 +128,6 @@ class VirtualRobotRig {
         drivers::LoadCellReaderOptions{config.load_cell.poll_interval_us, config.load_cell.fault_timeout_us,
                                        daemon::DaemonLoop::kReconnectIntervalUs});
     pose = std::make_unique<drivers::pose::PoseStreamSource>(config.pose.endpoint, clock);
-    store = std::make_unique<store::CalibrationStore>(config.store);
-    EXPECT_TRUE(store->open());
     loop = std::make_unique<daemon::DaemonLoop>(config, robot->nominal_robot(),
                                                 daemon::DaemonDevices{*winches, *load_cell_reader, *pose, nullptr}, *store,
                                                 clock, notifier, nullptr);

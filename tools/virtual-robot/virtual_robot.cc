@@ -116,6 +116,7 @@ void VirtualRobot::run_once(hal::TimeUs max_wait_us) {
   modbus_->service(fds_, now_us);  // also sends replies whose latency has passed
   physics_->advance(options_.time_scale * 1e-6 * static_cast<double>(now_us - last_us_));
   last_us_ = now_us;
+  for (int i = 0; i < kCableCount; ++i) payout_snapshot_m_[i].store(physics_->payout_m(i));
   publish(now_us);
 }
 

@@ -22,6 +22,7 @@
 // in real time, as the daemon's timeouts are. Not thread-safe: one thread
 // calls run_once()/run().
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <map>
@@ -82,6 +83,8 @@ class VirtualRobot {
   const Robot& nominal_robot() const { return data_.nominal; }
   const Truth& truth() const { return data_.truth; }
   const RobotPhysics& physics() const { return *physics_; }
+  // Winch i's payout [m] as of the last run_once(), readable from any thread.
+  double payout_snapshot_m(int winch) const { return payout_snapshot_m_[winch].load(); }
   CanopenNodes& nodes() { return *nodes_; }
   VirtualLoadCell& load_cell() { return *cell_; }
   // The pose stream's fault (any thread): kSilent stops sending, kGarbage
@@ -107,6 +110,7 @@ class VirtualRobot {
   std::unique_ptr<VirtualLoadCell> cell_;
   std::unique_ptr<ModbusTransport> modbus_;
   std::atomic<DeviceFault> pose_fault_{DeviceFault::kNone};
+  std::array<std::atomic<double>, kCableCount> payout_snapshot_m_{};
   std::map<int, std::string> can_partial_;  // per CAN client: bytes of an incomplete record
   hal::TimeUs last_us_ = 0;
   hal::TimeUs start_us_ = 0;

@@ -1,0 +1,159 @@
+// The fault table of the load cell (Modbus TCP and RTU) and the pose stream:
+// the daemon with its real drivers calibrates the virtual robot, and in the
+// middle of the run the device goes silent, disconnects or talks garbage.
+// For each: the time from the fault to the run's failure, whether the
+// winches stopped, whether the control socket answered every status request
+// within 100 ms throughout, and whether the previous calibration is intact.
+// Each row is printed (the table in docs/fieldbus.md comes from here).
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <thread>
+
+#include "../src/store/store_test_support.h"
+#include "virtual_robot_rig.h"
+
+namespace cdpr::integration {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using virtual_robot::DeviceFault;
+
+enum class Device { kLoadCellTcp, kLoadCellRtu, kPose };
+
+struct Scenario {
+  Device device;
+  DeviceFault fault;
+};
+
+const char* name(Device device) {
+  switch (device) {
+    case Device::kLoadCellTcp: return "load cell TCP";
+    case Device::kLoadCellRtu: return "load cell RTU";
+    case Device::kPose: return "pose stream";
+  }
+  return "?";
+}
+
+const char* name(DeviceFault fault) {
+  switch (fault) {
+    case DeviceFault::kSilent: return "silent";
+    case DeviceFault::kDisconnected: return "disconnected";
+    case DeviceFault::kGarbage: return "garbage";
+    case DeviceFault::kNone: return "none";
+  }
+  return "?";
+}
+
+// The timeouts an operator would configure (tighter than the rig's, which
+// allow for a loaded test machine).
+constexpr hal::TimeUs kLoadCellFaultTimeoutUs = 500'000;
+constexpr hal::TimeUs kPoseStaleUs = 500'000;
+constexpr double kStatusLimitMs = 100.0;
+
+class FaultTable : public ::testing::TestWithParam<Scenario> {};
+
+// The status request's round trip through the control socket [ms].
+double timed_status(VirtualRobotRig& rig, calibctl::JsonValue& status) {
+  const auto start = Clock::now();
+  status = rig.ask("status");
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+TEST_P(FaultTable, TheRunStopsSafelyAndTheDaemonStaysResponsive) {
+  const Scenario scenario = GetParam();
+  // GIVEN the virtual robot with its load cell on TCP or RTU, a previous
+  // calibration in the store, and the daemon with operator timeouts
+  virtual_robot::VirtualRobotOptions options = large_robot_acceptance_options();
+  options.modbus_rtu = scenario.device == Device::kLoadCellRtu;
+  VirtualRobotRig rig(options, [](VirtualRobotRig& r) {
+    r.config.load_cell.fault_timeout_us = kLoadCellFaultTimeoutUs;
+    r.config.calibrator.monitor.pose_stale_us = kPoseStaleUs;
+    Calibration previous = store::test::calibration_version(1);
+    for (int i = 0; i < kCableCount; ++i) {
+      previous.winches[i].anchor_world = r.robot->nominal_robot().winches[i].anchor_world;
+      previous.winches[i].offset_m = r.robot->truth().winches[i].offset_m;
+    }
+    EXPECT_TRUE(r.store->commit(previous));
+  });
+  const std::string current_path = rig.store->current_path();
+  const std::string previous_bytes = store::test::file_bytes(current_path);
+  double slowest_status_ms = 0.0;
+  calibctl::JsonValue status;
+  // WHEN a run is moving the winches towards its second waypoint
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  ASSERT_TRUE(rig.ask("start")["ok"].boolean());
+  const auto give_up = Clock::now() + std::chrono::seconds(60);
+  do {
+    slowest_status_ms = std::max(slowest_status_ms, timed_status(rig, status));
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  } while (!(status["state"].string() == "move" && status["waypoint"].integer() >= 2) &&
+           status["running"].boolean() && Clock::now() < give_up);
+  ASSERT_EQ(status["state"].string(), "move") << status["reason"].string();
+  // AND the device fails (the winches moving or not at that moment)
+  std::array<double, kCableCount> before_m{};
+  for (int i = 0; i < kCableCount; ++i) before_m[i] = rig.robot->payout_snapshot_m(i);
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  bool moving = false;
+  for (int i = 0; i < kCableCount; ++i) moving = moving || rig.robot->payout_snapshot_m(i) != before_m[i];
+  const auto failed_at = Clock::now();
+  if (scenario.device == Device::kPose) {
+    rig.robot->set_pose_fault(scenario.fault);
+  } else {
+    rig.robot->load_cell().set_fault(scenario.fault);
+  }
+  // THEN the run fails, the control socket answering every request meanwhile
+  do {
+    slowest_status_ms = std::max(slowest_status_ms, timed_status(rig, status));
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  } while (status["running"].boolean() && Clock::now() < failed_at + std::chrono::seconds(30));
+  const double time_to_fault_ms = std::chrono::duration<double, std::milli>(Clock::now() - failed_at).count();
+  ASSERT_EQ(status["state"].string(), "failed");
+  // AND the winches stand still from then on (and status keeps answering)
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  std::array<double, kCableCount> payout_m{};
+  for (int i = 0; i < kCableCount; ++i) payout_m[i] = rig.robot->payout_snapshot_m(i);
+  const auto watch_until = Clock::now() + std::chrono::seconds(1);
+  while (Clock::now() < watch_until) {
+    slowest_status_ms = std::max(slowest_status_ms, timed_status(rig, status));
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  double moved_m = 0.0;
+  for (int i = 0; i < kCableCount; ++i) moved_m = std::max(moved_m, std::abs(rig.robot->payout_snapshot_m(i) - payout_m[i]));
+  const bool stopped = moved_m < 1e-6;
+  const bool responsive = slowest_status_ms < kStatusLimitMs;
+  const bool intact = store::test::file_bytes(current_path) == previous_bytes && !previous_bytes.empty();
+  std::printf("| %s | %s | %.0f ms | %s (%s at the fault) | %s (slowest %.1f ms) | %s | %s |\n",
+              name(scenario.device), name(scenario.fault), time_to_fault_ms, stopped ? "yes" : "no",
+              moving ? "moving" : "still", responsive ? "yes" : "no", slowest_status_ms, intact ? "yes" : "no",
+              status["reason"].string().c_str());
+  EXPECT_TRUE(stopped) << "a winch moved " << moved_m << " m after the failure";
+  EXPECT_TRUE(responsive) << "slowest status " << slowest_status_ms << " ms";
+  EXPECT_TRUE(intact);
+  // A silent or garbage device is judged by its timeout (plus one Modbus
+  // transaction of 3 x 200 ms and the monitor's tolerance of 3 loop steps);
+  // a lost connection at once.
+  EXPECT_LT(time_to_fault_ms, 500.0 + 600.0 + 1000.0) << status["reason"].string();
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Rows, FaultTable,
+    ::testing::Values(Scenario{Device::kLoadCellTcp, DeviceFault::kSilent},
+                      Scenario{Device::kLoadCellTcp, DeviceFault::kDisconnected},
+                      Scenario{Device::kLoadCellTcp, DeviceFault::kGarbage},
+                      Scenario{Device::kLoadCellRtu, DeviceFault::kSilent},
+                      Scenario{Device::kLoadCellRtu, DeviceFault::kDisconnected},
+                      Scenario{Device::kLoadCellRtu, DeviceFault::kGarbage},
+                      Scenario{Device::kPose, DeviceFault::kSilent},
+                      Scenario{Device::kPose, DeviceFault::kDisconnected},
+                      Scenario{Device::kPose, DeviceFault::kGarbage}),
+    [](const auto& info) {
+      std::string text = std::string(name(info.param.device)) + "_" + name(info.param.fault);
+      std::replace(text.begin(), text.end(), ' ', '_');
+      return text;
+    });
+
+}  // namespace
+}  // namespace cdpr::integration
