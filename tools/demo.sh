@@ -2,7 +2,8 @@
 # make demo: the whole field calibration against the virtual robot, over the
 # real protocols, in the foreground without systemd:
 #   1. the virtual robot (large preset, physics time-scaled) serves CANopen on
-#      a Unix socket, a Modbus TCP load cell and a pose stream;
+#      a Unix socket, a Flintec FT-11 style load cell on Modbus RTU (a
+#      pseudo-terminal) and a pose stream;
 #   2. cdpr-calibd starts with a temporary state directory and a
 #      configuration pointing at those endpoints;
 #   3. `calibctl start` presses the button, `calibctl status --follow` shows
@@ -47,10 +48,10 @@ start=$(date +%s)
 echo "== virtual robot: large preset (240 x 220 x 50 m, 34 kg platform), physics 20x real time,"
 echo "   nominal anchors in robot.toml 0.3 m off the truth, encoder offsets unknown"
 "$build/tools/virtual-robot/virtual-robot" --preset large --seed 7 --time-scale 20 --anchor-perturbation 0.3 \
+  --modbus-transport rtu --load-cell-model flintec-ft-11 \
   --endpoints "$work/robot" >"$work/virtual-robot.log" 2>&1 &
 pids+=($!)
 wait_for "$work/robot/ready" 60
-modbus_port=$(sed -n 's/^modbus_port = //p' "$work/robot/ready")
 
 cat >"$work/cdpr-calibd.toml" <<EOF
 # cdpr-calibd against the virtual robot (keys: systemd/cdpr-calibd.toml)
@@ -62,7 +63,10 @@ socket = "$work/control"
 [winches]
 endpoint = "unix:$work/robot/can.sock"
 [load_cell]
-endpoint = "tcp:127.0.0.1:$modbus_port"
+# The virtual FT-11 shows kilograms with two decimals.
+endpoint = "rtu:$work/robot/load_cell.tty"
+preset = "flintec-ft-11"
+decimals = 2
 [pose]
 endpoint = "unix:$work/robot/pose.sock"
 [button]
