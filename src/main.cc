@@ -127,6 +127,10 @@ int main(int argc, char** argv) {
     log_line("robot: " + robot.error().message());
     return 1;
   }
+  if (const auto problem = daemon::check_config_against_robot(*config, *robot)) {
+    log_line("configuration: " + problem->message());
+    return 1;
+  }
   const drivers::can::CanWinchBankConfig winch_config = winch_bank_config(config->winches);
   const drivers::modbus::ModbusLoadCellConfig cell_config = load_cell_config(config->load_cell);
   for (const std::string& problem : {drivers::can::validate(winch_config), drivers::modbus::validate(cell_config)}) {
