@@ -1,6 +1,7 @@
 // calibctl: the operator's client of cdpr-calibd's control socket. Starts and
 // aborts a field calibration, shows its progress, the current calibration,
-// the stored versions, and rolls back to one of them.
+// the stored versions, rolls back to one of them, and retries a commit that
+// failed.
 //
 // Exit status: 0 done; 1 the daemon refused the request (or, with
 // status --follow, the run failed); 2 no daemon, or a broken connection.
@@ -113,6 +114,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(50, 60'000))->capture_default_str();
   app.add_subcommand("show", "the current calibration");
   app.add_subcommand("history", "the stored calibrations, newest first (* = current)");
+  app.add_subcommand("commit", "commit the calibration a failed commit kept in <state>/pending, once its cause is fixed");
   auto* rollback = app.add_subcommand("rollback", "make stored calibration SEQ current again");
   rollback->add_option("seq", options.seq, "sequence number (see history)")->required()->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
