@@ -85,11 +85,15 @@ void DaemonLoop::track_run() {
     }
     return;
   }
-  const char* state = calibration::to_string(s.state);
+  // Once per waypoint and when the motion ends (solve): each write costs two
+  // fsyncs on the loop thread, so not at every state change.
+  const bool moving = machine_->owns_hardware();
   if (run_marker_written_ && s.started_us == run_marker_started_us_ && s.waypoint == run_marker_now_.waypoint &&
-      run_marker_now_.state == state) {
+      moving == run_marker_moving_) {
     return;
   }
+  run_marker_moving_ = moving;
+  const char* state = calibration::to_string(s.state);
   const std::string now = utc_now_rfc3339();
   if (s.started_us != run_marker_started_us_) {
     run_marker_started_us_ = s.started_us;

@@ -120,6 +120,7 @@ class DaemonLoop {
   RunMarkerFile run_marker_;
   bool run_marker_written_ = false;
   bool run_marker_left_over_ = false;  // found at start-up, from a daemon that died mid-run
+  bool run_marker_moving_ = false;     // the marker was written while the machine owned the hardware
   RunMarker run_marker_now_;
   hal::TimeUs run_marker_started_us_ = -1;  // monotonic start of the run the marker describes
   std::string run_marker_error_;            // last logged write failure

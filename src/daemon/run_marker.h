@@ -9,10 +9,10 @@
 //   waypoints = 35                     # waypoints planned, 0 before planning
 //   state = "settle"                   # the state machine's state then
 //
-// The daemon loop writes it atomically (atomic_file.h) when a run starts and
-// at every change of state or waypoint, and removes it when the run ends
-// (done or failed). A daemon stopped by SIGTERM mid-run aborts the run and
-// leaves the marker: the next start reports that run too.
+// The daemon loop writes it atomically (atomic_file.h) when a run starts, at
+// every new waypoint and when the motion ends (solve), and removes it when
+// the run ends (done or failed). A daemon stopped by SIGTERM mid-run aborts
+// the run and leaves the marker: the next start reports that run too.
 //
 // Not thread-safe (the daemon's loop thread).
 
