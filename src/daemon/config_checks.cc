@@ -82,7 +82,8 @@ std::optional<FormatError> check_endpoints(const DaemonConfig& c) {
   if (auto p = endpoint(c, "load_cell.endpoint", c.load_cell.endpoint, {kTcp, kRtu})) return p;
   if (auto p = endpoint(c, "pose.endpoint", c.pose.endpoint, {kUnix, kTcp})) return p;
   if (!is_socket_path(c.control_socket)) {
-    return problem(c, "control.socket", "\"" + c.control_socket + "\" is longer than a Unix socket path may be (107 bytes)");
+    return problem(c, "control.socket",
+                   "\"" + c.control_socket + "\" is longer than a Unix socket path may be (107 bytes)");
   }
   return std::nullopt;
 }

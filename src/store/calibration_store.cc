@@ -181,7 +181,9 @@ std::vector<std::string> CalibrationStore::problems() const {
     return found;
   }
   for (const HistoryEntry& entry : *entries) {
-    if (!entry.valid) found.push_back("history entry " + std::to_string(entry.seq) + " is unreadable: " + entry.problem);
+    if (!entry.valid) {
+      found.push_back("history entry " + std::to_string(entry.seq) + " is unreadable: " + entry.problem);
+    }
   }
   return found;
 }

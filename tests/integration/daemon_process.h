@@ -31,7 +31,7 @@ inline std::string built_program(const std::string& relative_path) {
 
 class ChildProcess {
  public:
-  // Starts `argv` (argv[0]: the program's path) with stdout and stderr in `log_path`.
+  // Starts `argv` (argv[0]: a path, or a name looked up in PATH) with stdout and stderr in `log_path`.
   ChildProcess(const std::vector<std::string>& argv, std::string log_path) : log_path_(std::move(log_path)) {
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
@@ -40,7 +40,7 @@ class ChildProcess {
     std::vector<char*> args;
     for (const std::string& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
     args.push_back(nullptr);
-    if (posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), environ) != 0) pid_ = -1;
+    if (posix_spawnp(&pid_, args[0], &actions, nullptr, args.data(), environ) != 0) pid_ = -1;
     posix_spawn_file_actions_destroy(&actions);
     EXPECT_GT(pid_, 0) << "cannot start " << argv[0];
   }
