@@ -50,7 +50,8 @@ TEST(StoreProbe, AHistoryDirectoryThatCannotBeWrittenFailsNamingIt) {
   // WHEN probed THEN it fails, naming the probe file in that directory and the reason
   const auto probed = s.store.probe_writable();
   ASSERT_FALSE(probed);
-  EXPECT_TRUE(contains(probed.error().message(), s.store.history_dir() + "/.write-probe.tmp")) << probed.error().message();
+  EXPECT_TRUE(contains(probed.error().message(), s.store.history_dir() + "/.write-probe.tmp"))
+      << probed.error().message();
   EXPECT_TRUE(contains(probed.error().message(), "Not a directory")) << probed.error().message();
 }
 
