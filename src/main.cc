@@ -6,10 +6,11 @@
 // Runs under systemd (Type=notify: READY, STATUS, WATCHDOG via libsystemd)
 // or in the foreground (without NOTIFY_SOCKET the notifications are no-ops).
 // SIGTERM or SIGINT: the winches are stopped and the daemon exits 0.
-// Startup failures (bad configuration, robot.toml, state directory, control
-// socket) exit 1 so systemd can restart it; a device that is not there yet
-// is not a startup failure (the loop reconnects, and preflight refuses to
-// calibrate without it).
+// Startup failures (bad configuration, robot.toml, state directory, another
+// instance holding the state directory's lock, control socket) exit 1 so
+// systemd can restart it; a device that is not there yet is not a startup
+// failure (the loop reconnects, and preflight refuses to calibrate without
+// it).
 #include <systemd/sd-daemon.h>
 
 #include <atomic>
@@ -31,6 +32,7 @@
 #include "src/daemon/daemon_config.h"
 #include "src/load_cell_driver_config.h"
 #include "src/daemon/daemon_loop.h"
+#include "src/daemon/instance_lock.h"
 #include "src/formats/robot_toml.h"
 
 namespace {
@@ -113,6 +115,10 @@ int main(int argc, char** argv) {
     log_line("robot: " + robot.error().message());
     return 1;
   }
+  if (const auto problem = daemon::check_config_against_robot(*config, *robot)) {
+    log_line("configuration: " + problem->message());
+    return 1;
+  }
   const drivers::can::CanWinchBankConfig winch_config = winch_bank_config(config->winches);
   const drivers::modbus::ModbusLoadCellConfig cell_config = daemon::load_cell_driver_config(config->load_cell);
   for (const std::string& problem : {drivers::can::validate(winch_config), drivers::modbus::validate(cell_config)}) {
@@ -122,6 +128,13 @@ int main(int argc, char** argv) {
     }
   }
 
+  // Before the store is touched (open() removes temp files) and the control
+  // socket bound: a second instance must change nothing of the first's.
+  const auto lock = daemon::InstanceLock::acquire(config->store.state_dir);
+  if (!lock.ok()) {
+    log_line(lock.status().to_string());
+    return 1;
+  }
   store::CalibrationStore store(config->store);
   if (const auto opened = store.open(); !opened) {
     log_line("store: " + opened.error().message());

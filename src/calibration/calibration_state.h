@@ -3,6 +3,7 @@
 // status the daemon reports on the control socket.
 
 #include <string>
+#include <vector>
 
 #include "hal/clock.h"
 
@@ -42,6 +43,12 @@ struct CalibrationStatus {
   hal::TimeUs started_us = -1;        // monotonic start of the last run; -1 never
   hal::TimeUs state_entered_us = -1;  // when the current state was entered
   hal::TimeUs finished_us = -1;       // when the last run ended (done or failed)
+
+  // Kept across runs (not reset by a start):
+  std::vector<std::string> store_problems;  // what the last store check found unreadable
+  bool pending_commit = false;              // a fit whose commit failed waits in <state>/pending
+  // Reset by a start:
+  std::string interrupted;  // "run interrupted at <time>, waypoint k of n": a daemon died mid-run
 };
 
 }  // namespace cdpr::calibration

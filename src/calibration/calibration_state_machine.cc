@@ -3,6 +3,8 @@
 #include <utility>
 
 #include "src/calibration/message_text.h"
+#include "src/formats/samples_csv.h"
+#include "src/store/pending_calibration.h"
 
 namespace cdpr::calibration {
 namespace {
@@ -48,7 +50,10 @@ bool CalibrationStateMachine::request_start(hal::TimeUs now_us) {
                    ")";
     return false;
   }
-  status_ = CalibrationStatus{};
+  CalibrationStatus fresh;
+  fresh.store_problems = std::move(status_.store_problems);
+  fresh.pending_commit = status_.pending_commit;
+  status_ = std::move(fresh);
   status_.started_us = now_us;
   status_.note = "started";
   enable_sent_us_.reset();
@@ -87,8 +92,15 @@ void CalibrationStateMachine::fail(const std::string& reason, hal::TimeUs now_us
   status_.reason = reason + where;
   if (!stopped.ok()) status_.reason += "; stopping the winches failed: " + stopped.to_string();
   status_.reason += "; previous calibration kept";
+  status_.note = (fault ? "fault: " : "") + reason + where;
   status_.finished_us = now_us;
   enter(CalibrationState::kFailed, now_us);
+  refresh_store_problems();
+}
+
+void CalibrationStateMachine::refresh_store_problems() {
+  status_.store_problems = devices_.store.problems();
+  status_.pending_commit = store::PendingCalibration(devices_.store.state_dir()).exists();
 }
 
 void CalibrationStateMachine::poll_button(hal::TimeUs now_us) {
@@ -135,6 +147,11 @@ void CalibrationStateMachine::step(hal::TimeUs now_us) {
 
 void CalibrationStateMachine::run_preflight(hal::TimeUs now_us) {
   if (!enable_sent_us_) {
+    // Before anything moves: a run whose fit could not be committed would be wasted.
+    if (const auto probed = devices_.store.probe_writable(); !probed) {
+      return fail("the store cannot be written (" + probed.error().message() + "): a fit could not be committed",
+                  now_us, false);
+    }
     auto current = devices_.store.load_current();
     if (current) {
       previous_ = std::move(*current);
@@ -302,7 +319,7 @@ void CalibrationStateMachine::run_validate_and_commit(hal::TimeUs now_us) {
     return;
   }
   const auto committed = devices_.store.commit(calibration);
-  if (!committed) return fail("store: " + committed.error().message(), now_us, false);
+  if (!committed) return fail("store: " + committed.error().message() + keep_pending(calibration), now_us, false);
   status_.committed_seq = *committed;
   status_.reason = "committed calibration " + std::to_string(*committed) + " from " +
                    std::to_string(samples_.size()) + " samples (rms encoder " +
@@ -310,6 +327,15 @@ void CalibrationStateMachine::run_validate_and_commit(hal::TimeUs now_us) {
                    significant(calibration.fit.rms_force_n, 3) + " N)";
   status_.finished_us = now_us;
   enter(CalibrationState::kDone, now_us);
+  refresh_store_problems();
+}
+
+std::string CalibrationStateMachine::keep_pending(const Calibration& calibration) const {
+  const store::PendingCalibration pending(devices_.store.state_dir());
+  const auto kept = pending.keep(calibration, formats::format_samples_csv(samples_));
+  if (!kept) return "; keeping the fit in " + pending.dir() + " failed too: " + kept.error().message();
+  return "; the fit and its " + std::to_string(samples_.size()) + " samples are kept in " + pending.dir() +
+         ": fix the cause, then `calibctl commit`";
 }
 
 void CalibrationStateMachine::update_progress() {

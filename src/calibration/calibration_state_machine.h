@@ -7,8 +7,9 @@
 //     -> solve -> validate -> commit -> done
 //   any fault or abort request while running -> abort -> failed
 //
-// preflight  every winch alive, pose fresh and valid, load cell answering and
-//            the tension inside its limits; enable the drives and wait for
+// preflight  the store proves it can write (a run it could not commit is
+//            not started); every winch alive, pose fresh and valid, load cell
+//            answering and the tension inside its limits; enable the drives and wait for
 //            operation enabled (enable_timeout_us). Encoder offsets for the
 //            payout targets: the current calibration's, else estimated at the
 //            start pose (waypoint_planner.h).
@@ -28,9 +29,12 @@
 //            (from utc_now_text), `robot` and `samples` are filled in; the
 //            model terms are the solver's.
 // commit     CalibrationStore::commit(); a store error fails the run and the
-//            store guarantees the old file is intact.
+//            store guarantees the old file is intact. The fit and its
+//            samples are then kept in <state>/pending (pending_calibration.h)
+//            for a later `commit` request, so the run's work is not lost.
 // abort      quick stop for a fault, halt (decelerate and hold) for an abort
-//            request; the reason goes to status().reason.
+//            request; the reason goes to status().reason and, as the latest
+//            remark, to status().note.
 //
 // While running (preflight .. sample) every step polls the hardware once
 // (HardwareMonitor: winch update, pose update, one load-cell read) and any
@@ -113,6 +117,15 @@ class CalibrationStateMachine {
   // True while step() polls the devices (preflight .. sample).
   bool owns_hardware() const;
 
+  // Checks the stored files again (CalibrationStore::problems(), a pending
+  // commit) into status().store_problems and pending_commit. Done at the end
+  // of every run; the owner calls it at start-up and after it changed the
+  // store (rollback, commit of the pending fit).
+  void refresh_store_problems();
+  // Reports a run that a previous daemon did not finish (status().interrupted),
+  // until the next start.
+  void note_interrupted_run(std::string text) { status_.interrupted = std::move(text); }
+
   const CalibrationStatus& status() const { return status_; }
   const WaypointPlan& plan() const { return plan_; }
 
@@ -128,6 +141,8 @@ class CalibrationStateMachine {
   void next_waypoint(hal::TimeUs now_us);
   void run_solve(hal::TimeUs now_us);
   void run_validate_and_commit(hal::TimeUs now_us);
+  // Keeps a fit whose commit failed in <state>/pending; the sentence for the reason.
+  std::string keep_pending(const Calibration& calibration) const;
   void update_progress();
 
   const Robot robot_;

@@ -2,6 +2,7 @@
 
 #include "src/control/control_request.h"
 #include "src/control/control_response.h"
+#include "src/store/pending_calibration.h"
 
 namespace cdpr::control {
 
@@ -21,7 +22,9 @@ std::string respond(std::string_view request_line, calibration::CalibrationState
     case RequestKind::kStatus: return format_status_response(machine.status(), now_us);
     case RequestKind::kShow: {
       const auto current = store.load_current();
-      if (!current) return format_error_response(current.error().message());
+      if (!current) {
+        return format_error_response("the current calibration is unreadable: " + current.error().message());
+      }
       return format_show_response(*current);
     }
     case RequestKind::kHistory: {
@@ -34,9 +37,24 @@ std::string respond(std::string_view request_line, calibration::CalibrationState
         return format_error_response("rollback refused: a calibration is running (abort it first)");
       }
       const auto rolled = store.rollback(request->seq);
+      machine.refresh_store_problems();
       if (!rolled) return format_error_response("rollback to " + std::to_string(request->seq) + " failed: " +
                                                 rolled.error().message());
       return format_ok_response("calibration " + std::to_string(*rolled) + " is current");
+    }
+    case RequestKind::kCommit: {
+      if (calibration::is_running(machine.status().state)) {
+        return format_error_response("commit refused: a calibration is running");
+      }
+      const store::PendingCalibration pending(store.state_dir());
+      if (!pending.exists()) return format_error_response("nothing to commit: no fit is kept in " + pending.dir());
+      const auto committed = pending.commit_into(store);
+      machine.refresh_store_problems();
+      if (!committed) {
+        return format_error_response("commit of the fit kept in " + pending.dir() + " failed again: " +
+                                     committed.error().message());
+      }
+      return format_ok_response("committed calibration " + std::to_string(*committed) + " from " + pending.dir());
     }
   }
   return format_error_response("unhandled request");

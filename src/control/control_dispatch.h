@@ -5,8 +5,11 @@
 // passed in. Never throws; every outcome is one response line
 // (control_response.h).
 //
-// rollback is refused while a calibration runs (the run's validation compares
-// against the current file and its commit would overwrite the rollback).
+// rollback and commit are refused while a calibration runs (the run's
+// validation compares against the current file and its commit would
+// overwrite theirs). commit commits the fit a failed commit kept in
+// <state>/pending (pending_calibration.h); after either, the machine's view
+// of the store's problems is refreshed.
 
 #include <string>
 #include <string_view>

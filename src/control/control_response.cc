@@ -46,6 +46,11 @@ std::string format_status_response(const calibration::CalibrationStatus& status,
   }
   json.key("reason").value(status.reason).key("note").value(status.note).key("detail").value(status.detail);
   json.key("committed_seq").value(status.committed_seq);
+  json.key("interrupted").value(status.interrupted);
+  json.key("store_problems").begin_array();
+  for (const std::string& problem : status.store_problems) json.value(problem);
+  json.end_array();
+  json.key("pending_commit").value(status.pending_commit);
   json.end_object();
   return line(json);
 }

@@ -3,11 +3,15 @@
 // object terminated by "\n", never containing another newline.
 //
 //   error (any request)  {"ok":false,"error":"unknown command 'strat' (...)"}
-//   start/abort/rollback {"ok":true,"message":"started"}
+//   start/abort/rollback/commit {"ok":true,"message":"started"}
 //   status   {"ok":true,"state":"settle","running":true,"waypoint":3,"waypoints":35,
 //             "samples":2,"skipped":0,"progress":0.12,"elapsed_s":41.2,
-//             "reason":"","note":"","detail":"platform moving: ...","committed_seq":0}
+//             "reason":"","note":"","detail":"platform moving: ...","committed_seq":0,
+//             "interrupted":"","store_problems":[],"pending_commit":false}
 //            elapsed_s: since the last run started (to its end when finished); null if never run
+//            interrupted: "run interrupted at <time>, waypoint k of n ..." when a daemon died
+//            mid-run, until the next start; store_problems: unreadable stored files, one
+//            sentence each; pending_commit: a failed commit's fit waits for `commit`
 //   show     {"ok":true,"present":true,"seq":4,"created":"2026-11-22T10:15:00Z","robot":"large",
 //             "model":["catenary"],"samples":35,
 //             "winches":[{"anchor":[x,y,z],"anchor_sigma":[..],"offset":3.2,"offset_sigma":0.03},...],

@@ -24,9 +24,21 @@ hal::Status errno_status(const std::string& path, const char* operation) {
                      "control socket " + path + ": " + operation + ": " + std::strerror(errno));
 }
 
-// A socket file left behind by a crashed daemon is ours to replace; any other
-// file at the path is somebody else's and must not be deleted.
-hal::Status remove_stale_socket(const std::string& path) {
+// Whether something accepts connections at `address` now. Only a refused
+// connection (nobody listening) proves a socket file stale.
+bool someone_listens(const sockaddr_un& address) {
+  const int probe = socket(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  if (probe < 0) return false;
+  const bool refused = connect(probe, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) != 0 &&
+                       (errno == ECONNREFUSED || errno == ENOENT);
+  close(probe);
+  return !refused;
+}
+
+// A socket file left behind by a crashed daemon is ours to replace; a socket
+// somebody still listens on (another daemon) and any other file at the path
+// are somebody else's and must not be deleted.
+hal::Status remove_stale_socket(const std::string& path, const sockaddr_un& address) {
   struct stat info {};
   if (lstat(path.c_str(), &info) != 0) {
     if (errno == ENOENT) return hal::Status::Ok();
@@ -35,6 +47,11 @@ hal::Status remove_stale_socket(const std::string& path) {
   if (!S_ISSOCK(info.st_mode)) {
     return hal::Status(hal::ErrorCode::kInvalidArgument,
                        "control socket " + path + ": a file that is not a socket is in the way");
+  }
+  if (someone_listens(address)) {
+    return hal::Status(hal::ErrorCode::kInvalidState,
+                       "control socket " + path + ": another process is listening on it (a second cdpr-calibd?); "
+                       "left alone");
   }
   if (unlink(path.c_str()) != 0) return errno_status(path, "unlink stale socket");
   return hal::Status::Ok();
@@ -80,7 +97,7 @@ hal::Result<std::unique_ptr<ControlServer>> ControlServer::listen(const std::str
     if (!resolved.ok()) return resolved.status();
     gid = resolved.value();
   }
-  if (hal::Status removed = remove_stale_socket(path); !removed.ok()) return removed;
+  if (hal::Status removed = remove_stale_socket(path, address); !removed.ok()) return removed;
 
   const int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
   if (fd < 0) return errno_status(path, "socket");
@@ -100,22 +117,27 @@ hal::Result<std::unique_ptr<ControlServer>> ControlServer::listen(const std::str
   } else if (::listen(fd, static_cast<int>(kMaxClients)) != 0) {
     failed = "listen";
   }
+  struct stat bound {};
+  if (failed == nullptr && lstat(path.c_str(), &bound) != 0) failed = "lstat";
   if (failed != nullptr) {
     hal::Status status = errno_status(path, failed);
     close(fd);
     unlink(path.c_str());
     return status;
   }
-  return std::unique_ptr<ControlServer>(new ControlServer(fd, path, std::move(handler)));
+  return std::unique_ptr<ControlServer>(new ControlServer(fd, path, bound.st_dev, bound.st_ino, std::move(handler)));
 }
 
-ControlServer::ControlServer(int listen_fd, std::string path, Handler handler)
-    : listen_fd_(listen_fd), path_(std::move(path)), handler_(std::move(handler)) {}
+ControlServer::ControlServer(int listen_fd, std::string path, dev_t device, ino_t inode, Handler handler)
+    : listen_fd_(listen_fd), path_(std::move(path)), device_(device), inode_(inode), handler_(std::move(handler)) {}
 
 ControlServer::~ControlServer() {
   for (const auto& client : clients_) close(client->fd);
   close(listen_fd_);
-  unlink(path_.c_str());
+  // Only the file this server bound: if somebody replaced it meanwhile, the
+  // path is theirs now.
+  struct stat info {};
+  if (lstat(path_.c_str(), &info) == 0 && info.st_dev == device_ && info.st_ino == inode_) unlink(path_.c_str());
 }
 
 void ControlServer::append_poll_fds(std::vector<pollfd>& fds) const {

@@ -28,10 +28,12 @@
 // keeps the daemon's own group.
 //
 // Ownership: owns its listening and client sockets; the destructor closes
-// them and removes the socket path it created. Not thread-safe: one thread
+// them and removes the socket file it bound, and only that file (same device
+// and inode): never a socket another process put at the path since. Not thread-safe: one thread
 // (the daemon loop) calls everything, and the handler runs on that thread.
 
 #include <poll.h>
+#include <sys/types.h>
 
 #include <cstddef>
 #include <functional>
@@ -56,12 +58,13 @@ class ControlServer {
   // (with its "\n").
   using Handler = std::function<std::string(std::string_view request_line)>;
 
-  // Binds and listens at `path` (a stale socket left by a crash is removed;
-  // any other file there is refused), sets its mode to `mode` and, when
-  // `group` (a name or a numeric id) is not empty, its group.
+  // Binds and listens at `path` (a stale socket left by a crash, one nobody
+  // listens on, is removed; a live one or any other file there is refused
+  // and left alone), sets its mode to `mode` and, when `group` (a name or a
+  // numeric id) is not empty, its group.
   // Errors: kInvalidArgument (path too long, not a socket in the way, no
-  // such group), kIoError (socket, bind, listen, chmod, chown), each naming
-  // the path and errno.
+  // such group), kInvalidState (another process listens there), kIoError
+  // (socket, bind, listen, chmod, chown), each naming the path and errno.
   static hal::Result<std::unique_ptr<ControlServer>> listen(const std::string& path, Handler handler,
                                                            unsigned mode = 0660, const std::string& group = "");
   ~ControlServer();
@@ -99,7 +102,7 @@ class ControlServer {
     explicit Client(int client_fd, unsigned long long round);
   };
 
-  ControlServer(int listen_fd, std::string path, Handler handler);
+  ControlServer(int listen_fd, std::string path, dev_t device, ino_t inode, Handler handler);
   void accept_clients();
   // Closes the client whose last request is oldest, telling it why.
   void displace_stalest_client();
@@ -109,6 +112,8 @@ class ControlServer {
 
   int listen_fd_;
   std::string path_;
+  dev_t device_;  // of the socket file bound, so that only that file is removed
+  ino_t inode_;
   Handler handler_;
   std::vector<std::unique_ptr<Client>> clients_;
   Counters counters_;

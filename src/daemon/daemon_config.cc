@@ -3,6 +3,7 @@
 #include <cmath>
 #include <optional>
 
+#include "src/daemon/config_checks.h"
 #include "src/formats/text_file.h"
 #include "src/formats/toml_reader.h"
 
@@ -20,9 +21,11 @@ constexpr Presence kOptional = Presence::kOptional;
 // required keys and numbers). A value outside its range fails naming it.
 class ConfigReader {
  public:
-  explicit ConfigReader(TomlReader& reader) : reader_(reader) {}
+  ConfigReader(TomlReader& reader, std::map<std::string, int, std::less<>>& key_lines)
+      : reader_(reader), key_lines_(key_lines) {}
 
   void integer(const toml::table& t, std::string_view key, std::string_view path, int& out, long lo, long hi) {
+    note_line(t, key, path);
     if (!t.contains(key) || reader_.failed()) return;
     const std::int64_t value = reader_.integer(t, key, path);
     if (reader_.failed()) return;
@@ -33,22 +36,26 @@ class ConfigReader {
     out = static_cast<int>(value);
   }
   void number(const toml::table& t, std::string_view key, std::string_view path, double& out, Bound bound) {
+    note_line(t, key, path);
     if (const auto value = reader_.optional_number(t, key, path, bound)) out = *value;
   }
   // A duration key in the unit its name gives (`_ms` or `_s`), > 0.
   void duration_us(const toml::table& t, std::string_view key, std::string_view path, hal::TimeUs& out,
                    double us_per_unit) {
+    note_line(t, key, path);
     if (const auto value = reader_.optional_number(t, key, path, Bound::kPositive)) {
       out = static_cast<hal::TimeUs>(std::llround(*value * us_per_unit));
     }
   }
   void string(const toml::table& t, std::string_view key, std::string_view path, std::string& out) {
+    note_line(t, key, path);
     if (!t.contains(key) || reader_.failed()) return;
     std::string value = reader_.string(t, key, path);
     if (!reader_.failed() && value.empty()) fail(t, key, path, "must not be empty");
     if (!reader_.failed()) out = std::move(value);
   }
   void boolean(const toml::table& t, std::string_view key, std::string_view path, bool& out) {
+    note_line(t, key, path);
     const toml::node* node = t.get(key);
     if (node == nullptr || reader_.failed()) return;
     if (!node->is_boolean()) {
@@ -78,7 +85,12 @@ class ConfigReader {
   }
 
  private:
+  void note_line(const toml::table& t, std::string_view key, std::string_view path) {
+    if (const toml::node* node = t.get(key)) key_lines_[join_key(path, key)] = TomlReader::line_of(*node);
+  }
+
   TomlReader& reader_;
+  std::map<std::string, int, std::less<>>& key_lines_;
 };
 
 // What getgrnam() can be asked for and chown() given: a portable group name
@@ -330,7 +342,7 @@ DaemonConfig read_config(TomlReader& reader, const toml::table& root) {
                      {"button", kOptional}, {"limits", kOptional}, {"waypoints", kOptional},
                      {"equilibrium", kOptional}, {"solver", kOptional}, {"validation", kOptional}});
   c.robot_path = reader.string(root, "robot", "");
-  ConfigReader r(reader);
+  ConfigReader r(reader, c.key_lines);
   read_io(reader, r, root, c);
   read_calibration(reader, r, root, c);
   return c;
@@ -349,7 +361,11 @@ DaemonConfig default_daemon_config() {
 }
 
 Expected<DaemonConfig, FormatError> parse_daemon_config(std::string_view text, const std::string& source) {
-  return formats::parse_toml<DaemonConfig>(text, source, read_config);
+  auto config = formats::parse_toml<DaemonConfig>(text, source, read_config);
+  if (!config) return config;
+  config->source = source;
+  if (std::optional<FormatError> problem = check_cross_keys(*config)) return Unexpected{std::move(*problem)};
+  return config;
 }
 
 Expected<DaemonConfig, FormatError> read_daemon_config(const std::string& path) {

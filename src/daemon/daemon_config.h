@@ -11,12 +11,15 @@
 // Driver settings are plain values here (src/ does not see drivers/);
 // main() turns them into the drivers' own configurations.
 
+#include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "hal/clock.h"
 #include "solver/calibrate.h"
+#include "solver/robot.h"
 #include "src/calibration/calibration_state_machine.h"
 #include "src/daemon/load_cell_presets.h"
 #include "src/formats/expected.h"
@@ -82,6 +85,12 @@ struct DaemonConfig {
   ButtonConfig button;
   calibration::CalibratorOptions calibrator;  // [limits], [waypoints], [equilibrium], [validation]
   CalibrationOptions solver;                  // [solver]
+
+  // Where the configuration came from and the line of every key it set
+  // ("waypoints.z_max" -> 57), so that checks spanning several keys can
+  // name a line too. Keys left at their default are absent.
+  std::string source;
+  std::map<std::string, int, std::less<>> key_lines;
 };
 
 // A DaemonConfig with the defaults of systemd/cdpr-calibd.toml.
@@ -90,5 +99,10 @@ DaemonConfig default_daemon_config();
 // `source` names the input in messages (usually its path).
 Expected<DaemonConfig, FormatError> parse_daemon_config(std::string_view text, const std::string& source);
 Expected<DaemonConfig, FormatError> read_daemon_config(const std::string& path);
+
+// The checks that need robot.toml (config_checks.cc): the workspace the
+// margin leaves inside the anchors and the z band below them. nullopt when
+// the configuration suits the robot.
+std::optional<FormatError> check_config_against_robot(const DaemonConfig& config, const Robot& robot);
 
 }  // namespace cdpr::daemon

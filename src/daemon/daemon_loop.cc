@@ -25,7 +25,7 @@ DaemonLoop::DaemonLoop(const DaemonConfig& config, const Robot& robot, DaemonDev
                        store::CalibrationStore& store, const hal::Clock& clock, ServiceNotifier& notifier,
                        std::function<void(const std::string&)> log)
     : config_(config), robot_(robot), devices_(devices), store_(store), clock_(clock), notifier_(notifier),
-      log_(std::move(log)) {
+      log_(std::move(log)), run_marker_(store.state_dir()) {
   // No SolveFunction: the loop runs the fit on a worker thread (manage_solve).
   machine_ = std::make_unique<calibration::CalibrationStateMachine>(
       robot_,
@@ -41,12 +41,74 @@ hal::Status DaemonLoop::start() {
       config_.control_socket_group);
   if (!server.ok()) return server.status();
   server_ = std::move(server.value());
+  report_previous_state();
   const hal::TimeUs now_us = clock_.now_us();
   service_idle_devices(now_us);
   next_step_us_ = now_us;
   notifier_.ready();
   report(now_us);
   return hal::Status::Ok();
+}
+
+void DaemonLoop::report_previous_state() {
+  const auto marker = run_marker_.read();
+  std::string interrupted;
+  if (!marker) {
+    interrupted = "a run was interrupted (its marker is unreadable: " + marker.error() + ")";
+  } else if (*marker) {
+    interrupted = describe_interrupted_run(**marker);
+  }
+  if (!interrupted.empty()) {
+    run_marker_left_over_ = true;
+    machine_->note_interrupted_run(interrupted);
+    if (log_) log_(interrupted);
+  }
+  machine_->refresh_store_problems();
+  if (!log_) return;
+  for (const std::string& problem : machine_->status().store_problems) log_("store: " + problem);
+  if (machine_->status().pending_commit) {
+    log_("store: a fit whose commit failed is kept in " + store_.state_dir() +
+         "/pending; `calibctl commit` commits it once the cause is fixed");
+  }
+}
+
+void DaemonLoop::track_run() {
+  const calibration::CalibrationStatus& s = machine_->status();
+  if (!calibration::is_running(s.state)) {
+    // A marker a previous daemon left stays until a run of this one has
+    // started (and ended: a start and an abort may fall between two steps).
+    const bool left_over_done = run_marker_left_over_ && s.started_us >= 0;
+    if (!run_marker_written_ && !left_over_done) return;
+    run_marker_written_ = run_marker_left_over_ = false;
+    if (const auto removed = run_marker_.remove(); !removed && log_) {
+      log_("run marker: " + removed.error().message());
+    }
+    return;
+  }
+  // Once per waypoint and when the motion ends (solve): each write costs two
+  // fsyncs on the loop thread, so not at every state change.
+  const bool moving = machine_->owns_hardware();
+  if (run_marker_written_ && s.started_us == run_marker_started_us_ && s.waypoint == run_marker_now_.waypoint &&
+      moving == run_marker_moving_) {
+    return;
+  }
+  run_marker_moving_ = moving;
+  const char* state = calibration::to_string(s.state);
+  const std::string now = utc_now_rfc3339();
+  if (s.started_us != run_marker_started_us_) {
+    run_marker_started_us_ = s.started_us;
+    run_marker_now_.started = now;
+  }
+  run_marker_now_.updated = now;
+  run_marker_now_.waypoint = s.waypoint;
+  run_marker_now_.waypoints = s.waypoint_count;
+  run_marker_now_.state = state;
+  run_marker_written_ = true;  // also after a failed write: the end of the run removes what is there
+  const auto written = run_marker_.write(run_marker_now_);
+  // Logged once per kind of failure, not at every waypoint.
+  const std::string error = written ? std::string() : written.error().message();
+  if (error != run_marker_error_ && !error.empty() && log_) log_("run marker: " + error);
+  run_marker_error_ = error;
 }
 
 std::string DaemonLoop::handle_request(std::string_view line) {
@@ -81,6 +143,7 @@ void DaemonLoop::step(hal::TimeUs now_us) {
   if (!machine_->owns_hardware()) service_idle_devices(now_us);
   machine_->step(now_us);
   manage_solve(now_us);
+  track_run();
   report(now_us);
   notifier_.watchdog();
 }

@@ -12,6 +12,9 @@
 //   - when the machine does not own the devices: keeps the CAN bus and the
 //     pose stream drained and reconnects devices that are not open (every
 //     kReconnectIntervalUs), so a start finds fresh data,
+//   - keeps the run marker (run_marker.h) while a run is in progress, and
+//     at start reports a run a previous daemon left unfinished and what in
+//     the store is unreadable (log and status),
 //   - reports READY, STATUS and WATCHDOG through the ServiceNotifier.
 // shutdown() stops the winches (abort a run: halt; then quick stop) and
 // closes the devices; the owner calls it on SIGTERM and exits 0.
@@ -35,6 +38,7 @@
 #include "src/calibration/calibration_state_machine.h"
 #include "src/daemon/control_server.h"
 #include "src/daemon/daemon_config.h"
+#include "src/daemon/run_marker.h"
 #include "src/store/calibration_store.h"
 
 namespace cdpr::daemon {
@@ -88,6 +92,11 @@ class DaemonLoop {
   void manage_solve(hal::TimeUs now_us);
   void report(hal::TimeUs now_us);
   std::string handle_request(std::string_view line);
+  // Start-up: a run marker left by a daemon that died mid-run, and the
+  // store's problems, logged and put into the status.
+  void report_previous_state();
+  // Keeps the run marker (run_marker.h) in step with the machine's run.
+  void track_run();
 
   DaemonConfig config_;
   Robot robot_;
@@ -107,6 +116,14 @@ class DaemonLoop {
   hal::TimeUs next_step_us_ = 0;
   bool shut_down_ = false;
   std::string last_report_;
+
+  RunMarkerFile run_marker_;
+  bool run_marker_written_ = false;
+  bool run_marker_left_over_ = false;  // found at start-up, from a daemon that died mid-run
+  bool run_marker_moving_ = false;     // the marker was written while the machine owned the hardware
+  RunMarker run_marker_now_;
+  hal::TimeUs run_marker_started_us_ = -1;  // monotonic start of the run the marker describes
+  std::string run_marker_error_;            // last logged write failure
 };
 
 // RFC 3339 UTC time of the wall clock ("2026-11-22T10:15:00Z") for the

@@ -89,6 +89,20 @@ StoreResult<Done> fsync_directory(const std::string& dir) {
   return Done{};
 }
 
+StoreResult<Done> probe_writable(const std::string& dir) {
+  const std::string path = dir + "/" + temp_name("write-probe");
+  FileDescriptor file(::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
+  if (file.get() < 0) return Unexpected{errno_error("open", path)};
+  // A few bytes, so that a full disk or a failing device shows here, not at the commit.
+  const bool written = write_all(file.get(), "probe\n") && ::fsync(file.get()) == 0;
+  StoreResult<Done> result = Done{};
+  if (!written) result = Unexpected{errno_error("write and fsync", path)};
+  if (!file.close() && result) result = Unexpected{errno_error("close", path)};
+  if (::unlink(path.c_str()) != 0 && result) result = Unexpected{errno_error("unlink", path)};
+  if (!result) return result;
+  return fsync_directory(dir);
+}
+
 StoreResult<std::string> read_file(const std::string& path) {
   FileDescriptor file(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
   if (file.get() < 0) return Unexpected{errno_error("open", path)};

@@ -37,6 +37,12 @@ inline constexpr int kAtomicRenameStepOffset = 3;
 // fsync of a directory, so that renames and unlinks inside it are durable.
 [[nodiscard]] StoreResult<Done> fsync_directory(const std::string& dir);
 
+// Proves that files can be made durable in `dir` now: "<dir>/.write-probe.tmp"
+// created, written, fsynced, closed and removed, then the directory fsynced.
+// The error names the step and errno (EROFS, ENOSPC, EACCES, ENOTDIR, EIO).
+// A probe a crash leaves behind is a stale temp file (".<name>.tmp").
+[[nodiscard]] StoreResult<Done> probe_writable(const std::string& dir);
+
 // Whole-file read with errno on failure (ENOENT when absent).
 [[nodiscard]] StoreResult<std::string> read_file(const std::string& path);
 

@@ -162,6 +162,32 @@ StoreResult<int> CalibrationStore::rollback(int seq) {
   return seq;
 }
 
+StoreResult<Done> CalibrationStore::probe_writable() const {
+  for (const std::string& dir : {options_.state_dir, history_dir()}) {
+    if (auto probed = store::probe_writable(dir); !probed) return probed;
+  }
+  return Done{};
+}
+
+std::vector<std::string> CalibrationStore::problems() const {
+  std::vector<std::string> found;
+  if (const auto current = load_current(); !current) {
+    found.push_back("the current calibration is unreadable (" + current.error().message() +
+                    "): the robot controller cannot use it; roll back to a good version or calibrate");
+  }
+  const auto entries = history();
+  if (!entries) {
+    found.push_back("the history cannot be listed: " + entries.error().message());
+    return found;
+  }
+  for (const HistoryEntry& entry : *entries) {
+    if (!entry.valid) {
+      found.push_back("history entry " + std::to_string(entry.seq) + " is unreadable: " + entry.problem);
+    }
+  }
+  return found;
+}
+
 StoreResult<std::vector<HistoryEntry>> CalibrationStore::history() const {
   const auto seqs = history_seqs();
   if (!seqs) return Unexpected{seqs.error()};

@@ -87,6 +87,15 @@ class CalibrationStore {
   // All history entries, newest first.
   [[nodiscard]] StoreResult<std::vector<HistoryEntry>> history() const;
 
+  // Proves a commit could write now (probe_writable() in the state and the
+  // history directory): a run calls it before it moves anything.
+  [[nodiscard]] StoreResult<Done> probe_writable() const;
+
+  // What is wrong with the stored files, one operator sentence each: an
+  // unreadable or unparsable calibration.toml, unreadable history entries,
+  // a history that cannot be listed. Empty when all is well.
+  std::vector<std::string> problems() const;
+
   // Test hook: stop as if killed after step k (see above).
   void set_crash_hook(CrashHook hook) { crash_hook_ = std::move(hook); }
 

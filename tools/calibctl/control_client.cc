@@ -1,7 +1,9 @@
 #include "calibctl/control_client.h"
 
+#include <grp.h>
 #include <poll.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
 
@@ -25,10 +27,29 @@ bool ControlClient::connect(const std::string& socket_path, std::string& error) 
   std::memcpy(address.sun_path, socket_path.c_str(), socket_path.size() + 1);
   fd_ = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
   if (fd_ < 0 || ::connect(fd_, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) != 0) {
-    error = "cannot connect to " + socket_path + ": " + std::strerror(errno) + " (is cdpr-calibd running?)";
+    error = connect_error(socket_path, errno);
     return false;
   }
   return true;
+}
+
+std::string connect_error(const std::string& socket_path, int error_number) {
+  const std::string failed = "cannot connect to " + socket_path + ": ";
+  if (error_number == EACCES || error_number == EPERM) {
+    // Mode 0660: the daemon's user and the socket's group may connect.
+    struct stat info {};
+    if (stat(socket_path.c_str(), &info) != 0) {
+      return failed + "permission denied: its directory is closed to you (the daemon's runtime directory; "
+                      "see [control] group in cdpr-calibd.toml)";
+    }
+    const group* owner_group = getgrgid(info.st_gid);
+    const std::string name = owner_group ? owner_group->gr_name : std::to_string(info.st_gid);
+    return failed + "permission denied: only members of group '" + name +
+           "' may control cdpr-calibd (ask to be added: usermod -aG " + name + " <user>, then log in again)";
+  }
+  std::string text = failed + std::strerror(error_number);
+  if (error_number == ENOENT || error_number == ECONNREFUSED) text += " (is cdpr-calibd running?)";
+  return text;
 }
 
 bool ControlClient::request(const std::string& request, std::string& response, std::string& error, int timeout_ms) {

@@ -15,7 +15,7 @@ class ControlClient {
   ControlClient(const ControlClient&) = delete;
   ControlClient& operator=(const ControlClient&) = delete;
 
-  // false with `error` set ("cannot connect to /run/...: No such file or directory").
+  // false with `error` set (connect_error below).
   bool connect(const std::string& socket_path, std::string& error);
   // Sends `request` (a "\n" is appended) and waits at most timeout_ms for
   // the response line, returned without its "\n". false with `error` set
@@ -26,5 +26,11 @@ class ControlClient {
   int fd_ = -1;
   std::string buffered_;  // bytes after the last response line
 };
+
+// Why connecting to `socket_path` failed with `error_number`, for the
+// operator: a permission error names the group that may control the daemon;
+// only a missing socket or a refused connection suggests the daemon is not
+// running.
+std::string connect_error(const std::string& socket_path, int error_number);
 
 }  // namespace cdpr::calibctl

@@ -1,6 +1,7 @@
 // calibctl: the operator's client of cdpr-calibd's control socket. Starts and
 // aborts a field calibration, shows its progress, the current calibration,
-// the stored versions, and rolls back to one of them.
+// the stored versions, rolls back to one of them, and retries a commit that
+// failed.
 //
 // Exit status: 0 done; 1 the daemon refused the request (or, with
 // status --follow, the run failed); 2 no daemon, or a broken connection.
@@ -15,6 +16,7 @@
 #include "calibctl/control_client.h"
 #include "calibctl/json_value.h"
 #include "calibctl/render.h"
+#include "src/control/control_response.h"
 
 namespace {
 
@@ -32,24 +34,36 @@ struct Options {
   int seq = 0;
 };
 
-// Sends one request; prints the error and returns nullopt when it fails.
+// A failure: on stderr for the operator and, with --json, on stdout as one
+// JSON object ({"ok":false,"error":...}, the daemon's own when it refused),
+// so that a script always reads one object.
+void report_failure(bool json, const std::string& error, const std::string& daemon_response = {}) {
+  std::fprintf(stderr, "calibctl: %s\n", error.c_str());
+  if (!json) return;
+  const std::string object =
+      daemon_response.empty() ? cdpr::control::format_error_response(error) : daemon_response + "\n";
+  std::fputs(object.c_str(), stdout);
+}
+
+// Sends one request; reports the failure and returns nullopt when it fails.
 // `raw` receives the response line as the daemon sent it.
-std::optional<JsonValue> ask(ControlClient& client, const std::string& request, int& exit_code, std::string& raw) {
+std::optional<JsonValue> ask(ControlClient& client, const std::string& request, bool json, int& exit_code,
+                             std::string& raw) {
   std::string& response = raw;
   std::string error;
   if (!client.request(request, response, error)) {
-    std::fprintf(stderr, "calibctl: %s\n", error.c_str());
+    report_failure(json, error);
     exit_code = kExitNoDaemon;
     return std::nullopt;
   }
   auto value = JsonValue::parse(response, &error);
   if (!value) {
-    std::fprintf(stderr, "calibctl: unreadable response (%s): %s\n", error.c_str(), response.c_str());
+    report_failure(json, "unreadable response (" + error + "): " + response);
     exit_code = kExitNoDaemon;
     return std::nullopt;
   }
   if (!(*value)["ok"].boolean()) {
-    std::fprintf(stderr, "calibctl: %s: %s\n", request.c_str(), (*value)["error"].string().c_str());
+    report_failure(json, request + ": " + (*value)["error"].string(), response);
     exit_code = kExitRefused;
     return std::nullopt;
   }
@@ -62,7 +76,7 @@ int follow(ControlClient& client, const Options& options) {
   int exit_code = 0;
   for (;;) {
     std::string raw;
-    const auto status = ask(client, "status", exit_code, raw);
+    const auto status = ask(client, "status", options.json, exit_code, raw);
     if (!status) return exit_code;
     const std::string line = options.json ? raw : cdpr::calibctl::render_progress(*status);
     if (line != last) {
@@ -86,8 +100,11 @@ int main(int argc, char** argv) {
   if (const char* env = std::getenv("CDPR_CALIB_SOCKET")) options.socket_path = env;
   app.add_option("--socket", options.socket_path, "the daemon's control socket (env CDPR_CALIB_SOCKET)")
       ->capture_default_str();
-  app.add_flag("--json", options.json, "print the daemon's JSON response instead of text");
+  app.add_flag("--json", options.json,
+               "print the daemon's JSON response instead of text (a failure too, as {\"ok\":false,\"error\":...})");
   app.require_subcommand(1);
+  // Options of calibctl itself are accepted after the subcommand too (`status --json`).
+  app.fallthrough();
   auto* start = app.add_subcommand("start", "start a field calibration (as the button does)");
   start->add_flag("--follow,-f", options.follow, "then show progress until the run ends");
   app.add_subcommand("abort", "abort the calibration in progress (winches halted, old calibration kept)");
@@ -97,6 +114,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(50, 60'000))->capture_default_str();
   app.add_subcommand("show", "the current calibration");
   app.add_subcommand("history", "the stored calibrations, newest first (* = current)");
+  app.add_subcommand("commit",
+                     "commit the calibration a failed commit kept in <state>/pending, once its cause is fixed");
   auto* rollback = app.add_subcommand("rollback", "make stored calibration SEQ current again");
   rollback->add_option("seq", options.seq, "sequence number (see history)")->required()->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
@@ -105,14 +124,14 @@ int main(int argc, char** argv) {
   ControlClient client;
   std::string error;
   if (!client.connect(options.socket_path, error)) {
-    std::fprintf(stderr, "calibctl: %s\n", error.c_str());
+    report_failure(options.json, error);
     return kExitNoDaemon;
   }
   const std::string request = command == "rollback" ? "rollback " + std::to_string(options.seq) : command;
   int exit_code = 0;
   if (command == "status" && options.follow) return follow(client, options);
   std::string raw;
-  const auto response = ask(client, request, exit_code, raw);
+  const auto response = ask(client, request, options.json, exit_code, raw);
   if (!response) return exit_code;
   using namespace cdpr::calibctl;
   if (options.json) {

@@ -35,6 +35,11 @@ std::string render_status(const JsonValue& s) {
   append_if(out, "note", s["note"]);
   append_if(out, "reason", s["reason"]);
   if (s["committed_seq"].integer() > 0) out += format("  committed: calibration %d\n", s["committed_seq"].integer());
+  append_if(out, "interrupted", s["interrupted"]);
+  for (const JsonValue& problem : s["store_problems"].array()) append_if(out, "store", problem);
+  if (s["pending_commit"].boolean()) {
+    out += "  pending: a fit whose commit failed is kept; `calibctl commit` commits it once the cause is fixed\n";
+  }
   return out;
 }
 

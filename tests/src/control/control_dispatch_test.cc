@@ -24,7 +24,7 @@ TEST(ControlDispatch, StatusOfAnIdleDaemon) {
   EXPECT_EQ(ask(rig, "status"),
             "{\"ok\":true,\"state\":\"idle\",\"running\":false,\"waypoint\":0,\"waypoints\":0,\"samples\":0,"
             "\"skipped\":0,\"progress\":0,\"elapsed_s\":null,\"reason\":\"\",\"note\":\"\",\"detail\":\"\","
-            "\"committed_seq\":0}\n");
+            "\"committed_seq\":0,\"interrupted\":\"\",\"store_problems\":[],\"pending_commit\":false}\n");
 }
 
 TEST(ControlDispatch, StartTwiceAbortAndRollbackWhileRunning) {

@@ -23,7 +23,7 @@ TEST(ControlRequest, EveryCommandParses) {
 TEST(ControlRequest, MistakesAreRefusedWithAReason) {
   // GIVEN malformed requests WHEN parsed THEN each error says what is wrong
   EXPECT_EQ(parse_request("strat").error(),
-            "unknown command 'strat' (expected start, abort, status, show, history or rollback <seq>)");
+            "unknown command 'strat' (expected start, abort, status, show, history, rollback <seq> or commit)");
   EXPECT_EQ(parse_request("").error().substr(0, 13), "empty request");
   EXPECT_EQ(parse_request("START").error().substr(0, 15), "unknown command");
   EXPECT_EQ(parse_request("start now").error(), "start takes no argument");

@@ -15,47 +15,14 @@
 
 #include <gtest/gtest.h>
 
-#include "../../fakes/fake_load_cell.h"
-#include "../../fakes/fake_pose_source.h"
-#include "../../fakes/fake_winch_bank.h"
-#include "../../fakes/manual_clock.h"
-#include "../../solver/test_robots.h"
 #include "../store/store_test_support.h"
-#include "src/daemon/daemon_loop.h"
+#include "daemon_on_fakes.h"
 #include "test_groups.h"
 
 namespace cdpr::daemon {
 namespace {
 
-class SilentNotifier final : public ServiceNotifier {
- public:
-  void ready() override {}
-  void status(const std::string&) override {}
-  void watchdog() override {}
-  void stopping() override {}
-};
-
-// A daemon loop on fakes, configured from cdpr-calibd.toml text.
-class DaemonOnFakes {
- public:
-  explicit DaemonOnFakes(const DaemonConfig& config)
-      : load_cell_(clock_), pose_(clock_), store_(config.store),
-        loop_(config, test::large_robot(), DaemonDevices{winches_, load_cell_, pose_, nullptr}, store_, clock_,
-              notifier_, nullptr) {}
-  hal::Status start() {
-    if (!store_.open()) return hal::Status(hal::ErrorCode::kIoError, "store");
-    return loop_.start();
-  }
-
- private:
-  fakes::ManualClock clock_{1'000'000};
-  fakes::FakeWinchBank winches_;
-  fakes::FakeLoadCell load_cell_;
-  fakes::FakePoseSource pose_;
-  SilentNotifier notifier_;
-  store::CalibrationStore store_;
-  DaemonLoop loop_;
-};
+using test::DaemonOnFakes;
 
 // The state directory and control socket in `dir`; `control_lines` are
 // added to [control].

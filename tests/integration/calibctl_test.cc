@@ -1,0 +1,178 @@
+// calibctl as a script and an operator see it, the real program against a
+// control socket served in this process: with --json every outcome, a
+// failure too, is one JSON object on stdout; --json may follow the
+// subcommand; a permission error names the group that may control the
+// daemon instead of suggesting it is not running.
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "src/daemon/control_server.h"
+
+namespace cdpr::integration {
+namespace {
+
+constexpr uid_t kNobody = 65534;
+
+struct Outcome {
+  int exit_status = -1;
+  std::string out, err;
+};
+
+std::string file_text(const std::string& path) {
+  std::ifstream file(path);
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+// A temporary directory others may enter (calibctl runs as nobody in one test).
+class OpenDir {
+ public:
+  OpenDir() {
+    char pattern[] = "/tmp/cdpr-calibctl-XXXXXX";
+    path = mkdtemp(pattern);
+    chmod(path.c_str(), 0755);
+    // A copy others may run: the build tree need not be open to them.
+    program = path + "/calibctl";
+    std::filesystem::copy_file(std::string(CDPR_BINARY_DIR) + "/tools/calibctl/calibctl", program);
+    chmod(program.c_str(), 0755);
+  }
+  ~OpenDir() { std::filesystem::remove_all(path); }
+
+  // Runs calibctl with `args`, as `uid` when given (root only).
+  Outcome calibctl(const std::vector<std::string>& args, uid_t uid = 0) const {
+    const std::string out_path = path + "/out", err_path = path + "/err";
+    const pid_t pid = fork();
+    if (pid == 0) {
+      const int out = open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0666);
+      const int err = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0666);
+      dup2(out, 1);
+      dup2(err, 2);
+      if (uid != 0 && (setgid(uid) != 0 || setuid(uid) != 0)) _exit(125);
+      std::vector<char*> argv{const_cast<char*>(program.c_str())};
+      for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
+      argv.push_back(nullptr);
+      execv(program.c_str(), argv.data());
+      _exit(126);
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, file_text(out_path), file_text(err_path)};
+  }
+
+  std::string path, program;
+};
+
+// A control socket answering like the daemon, served on a thread.
+class StubDaemon {
+ public:
+  explicit StubDaemon(const std::string& socket) {
+    auto server = daemon::ControlServer::listen(socket, [](std::string_view line) -> std::string {
+      if (line == "status") return std::string(kStatus) + "\n";
+      return "{\"ok\":false,\"error\":\"abort ignored: no calibration running\"}\n";
+    });
+    EXPECT_TRUE(server.ok()) << server.status().to_string();
+    server_ = std::move(server.value());
+    thread_ = std::thread([this] {
+      while (!stop_.load()) {
+        std::vector<pollfd> fds;
+        server_->append_poll_fds(fds);
+        poll(fds.data(), fds.size(), 10);
+        server_->service(fds);
+      }
+    });
+  }
+  ~StubDaemon() {
+    stop_.store(true);
+    thread_.join();
+  }
+  static constexpr const char* kStatus =
+      "{\"ok\":true,\"state\":\"idle\",\"running\":false,\"waypoint\":0,\"waypoints\":0,\"samples\":0,"
+      "\"skipped\":0,\"progress\":0,\"elapsed_s\":null,\"reason\":\"\",\"note\":\"\",\"detail\":\"\","
+      "\"committed_seq\":0,\"interrupted\":\"\",\"store_problems\":[],\"pending_commit\":false}";
+
+ private:
+  std::unique_ptr<daemon::ControlServer> server_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+bool contains(const std::string& text, const std::string& words) { return text.find(words) != std::string::npos; }
+
+TEST(Calibctl, JsonBeforeOrAfterTheSubcommandPrintsTheDaemonsObject) {
+  // GIVEN a daemon's control socket
+  OpenDir dir;
+  const std::string socket = dir.path + "/control";
+  StubDaemon daemon(socket);
+  for (const std::vector<std::string>& args : {std::vector<std::string>{"--socket", socket, "--json", "status"},
+                                               {"--socket", socket, "status", "--json"},
+                                               {"status", "--json", "--socket", socket}}) {
+    // WHEN status is asked with --json in any place
+    const Outcome outcome = dir.calibctl(args);
+    // THEN the daemon's object is printed, exit 0
+    EXPECT_EQ(outcome.exit_status, 0) << outcome.err;
+    EXPECT_EQ(outcome.out, std::string(StubDaemon::kStatus) + "\n");
+  }
+}
+
+TEST(Calibctl, AFailureWithJsonIsStillOneJsonObjectOnStdout) {
+  OpenDir dir;
+  const std::string socket = dir.path + "/control";
+  // GIVEN no daemon WHEN status --json THEN an error object on stdout, the hint that it may not run, exit 2
+  const Outcome none = dir.calibctl({"--socket", socket, "status", "--json"});
+  EXPECT_EQ(none.exit_status, 2);
+  EXPECT_EQ(none.out.substr(0, 31), "{\"ok\":false,\"error\":\"cannot con") << none.out;
+  EXPECT_TRUE(contains(none.out, "No such file or directory (is cdpr-calibd running?)\"}\n")) << none.out;
+  // AND GIVEN a daemon that refuses WHEN abort --json THEN its error object on stdout, exit 1
+  StubDaemon daemon(socket);
+  const Outcome refused = dir.calibctl({"--socket", socket, "abort", "--json"});
+  EXPECT_EQ(refused.exit_status, 1);
+  EXPECT_EQ(refused.out, "{\"ok\":false,\"error\":\"abort ignored: no calibration running\"}\n");
+  // AND without --json stdout stays empty and stderr says it
+  const Outcome text = dir.calibctl({"--socket", socket, "abort"});
+  EXPECT_EQ(text.exit_status, 1);
+  EXPECT_EQ(text.out, "");
+  EXPECT_TRUE(contains(text.err, "abort ignored: no calibration running")) << text.err;
+}
+
+TEST(Calibctl, APermissionErrorNamesTheGroupNotAMissingDaemon) {
+  if (geteuid() != 0) GTEST_SKIP() << "needs root to run calibctl as another user";
+  // GIVEN a daemon's socket, mode 0660, group root, in a directory others may enter
+  OpenDir dir;
+  const std::string socket = dir.path + "/control";
+  StubDaemon daemon(socket);
+  ASSERT_EQ(chown(socket.c_str(), 0, 0), 0);
+  // WHEN a user outside the group asks for status (with --json)
+  const Outcome outcome = dir.calibctl({"--socket", socket, "status", "--json"}, kNobody);
+  // THEN it says permission denied and which group may control the daemon, not that it may not run
+  EXPECT_EQ(outcome.exit_status, 2);
+  EXPECT_TRUE(contains(outcome.err, "permission denied: only members of group 'root' may control cdpr-calibd"))
+      << outcome.err;
+  EXPECT_FALSE(contains(outcome.err, "is cdpr-calibd running")) << outcome.err;
+  EXPECT_TRUE(contains(outcome.out, "{\"ok\":false,\"error\":\"cannot connect to " + socket + ": permission denied"))
+      << outcome.out;
+  // AND WHEN the socket's directory is closed to them THEN it says that
+  chmod(dir.path.c_str(), 0711);
+  const std::string inner = dir.path + "/closed";
+  mkdir(inner.c_str(), 0700);
+  StubDaemon closed(inner + "/control");
+  const Outcome hidden = dir.calibctl({"--socket", inner + "/control", "status"}, kNobody);
+  EXPECT_EQ(hidden.exit_status, 2);
+  EXPECT_TRUE(contains(hidden.err, "permission denied: its directory is closed to you")) << hidden.err;
+}
+
+}  // namespace
+}  // namespace cdpr::integration

@@ -1,0 +1,70 @@
+// A daemon killed with SIGKILL mid-run, as real processes against the
+// virtual robot: the run marker it kept says where it was, a restarted
+// daemon (the lock died with the first) reports "run interrupted at <time>,
+// waypoint k of n" in its log and its status until the next start.
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+
+#include "virtual_robot_process.h"
+
+namespace cdpr::integration {
+namespace {
+
+using namespace std::chrono_literals;
+
+TEST(InterruptedRun, ADaemonKilledMidRunIsReportedAfterRestartUntilTheNextStart) {
+  // GIVEN the virtual small robot and a daemon calibrating it, at waypoint 2 or later
+  VirtualRobotProcess rig;
+  auto first = rig.start_daemon("first");
+  ASSERT_TRUE(wait_until([&] { return rig.answers(); }, 30s)) << first->log();
+  std::this_thread::sleep_for(1s);  // the CANopen nodes' first heartbeats
+  ASSERT_TRUE(rig.ask("start")["ok"].boolean()) << first->log();
+  calibctl::JsonValue status;
+  ASSERT_TRUE(wait_until(
+      [&] {
+        status = rig.ask("status");
+        return status["waypoint"].integer() >= 2 || !status["running"].boolean();
+      },
+      120s))
+      << first->log();
+  ASSERT_TRUE(status["running"].boolean()) << status["reason"].string() << "\n" << first->log();
+  const int waypoint_seen = status["waypoint"].integer();
+  const int waypoints = status["waypoints"].integer();
+
+  // WHEN the daemon is killed with SIGKILL and started again
+  first->signal(SIGKILL);
+  ASSERT_EQ(first->wait_exit(10s), std::optional<int>(128 + SIGKILL));
+  EXPECT_TRUE(std::filesystem::exists(rig.state_dir + "/run-in-progress.toml"));
+  auto second = rig.start_daemon("second");
+  ASSERT_TRUE(wait_until([&] { return rig.answers(); }, 30s)) << second->log();
+
+  // THEN its status and log say the run was interrupted, at which waypoint of how many
+  const std::string interrupted = rig.ask("status")["interrupted"].string();
+  std::printf("after restart: %s\n", interrupted.c_str());
+  EXPECT_EQ(interrupted.rfind("run interrupted at 20", 0), 0u) << interrupted;
+  const std::size_t at = interrupted.find(", waypoint ");
+  ASSERT_NE(at, std::string::npos) << interrupted;
+  const int waypoint_reported = std::atoi(interrupted.c_str() + at + 11);
+  EXPECT_GE(waypoint_reported, waypoint_seen) << interrupted;
+  EXPECT_LE(waypoint_reported, waypoint_seen + 1) << interrupted;  // it may have moved on before the kill
+  EXPECT_NE(interrupted.find(" of " + std::to_string(waypoints) + " ("), std::string::npos) << interrupted;
+  EXPECT_NE(second->log().find("cdpr-calibd: run interrupted at "), std::string::npos) << second->log();
+  // AND calibctl status shows it to the operator
+  ChildProcess calibctl({built_program("tools/calibctl/calibctl"), "--socket", rig.socket, "status"},
+                        rig.dir + "/calibctl.log");
+  EXPECT_EQ(calibctl.wait_exit(30s), std::optional<int>(0));
+  EXPECT_NE(calibctl.log().find("\n  interrupted: run interrupted at 20"), std::string::npos) << calibctl.log();
+
+  // AND WHEN a new run starts THEN the report is gone; once it is aborted the marker is removed
+  ASSERT_TRUE(rig.ask("start")["ok"].boolean()) << second->log();
+  EXPECT_EQ(rig.ask("status")["interrupted"].string(), "");
+  EXPECT_TRUE(rig.ask("abort")["ok"].boolean());
+  EXPECT_TRUE(wait_until([&] { return !std::filesystem::exists(rig.state_dir + "/run-in-progress.toml"); }, 10s));
+  second->signal(SIGTERM);
+  EXPECT_EQ(second->wait_exit(30s), std::optional<int>(0)) << second->log();
+}
+
+}  // namespace
+}  // namespace cdpr::integration

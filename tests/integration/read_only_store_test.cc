@@ -1,0 +1,116 @@
+// A really read-only store (a read-only bind mount in the daemon's own mount
+// namespace: EROFS, which holds for root too), with the real daemon against
+// the virtual robot: read-only from the start, the run is refused in
+// preflight before anything moves; turning read-only during the run, the
+// commit fails, the fit and samples are kept in pending/, and
+// `calibctl commit` commits them once the store is writable again.
+// Skipped where mount namespaces are not allowed.
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "virtual_robot_process.h"
+
+namespace cdpr::integration {
+namespace {
+
+using namespace std::chrono_literals;
+
+bool mount_namespaces_allowed() { return std::system("unshare -m --propagation private true 2>/dev/null") == 0; }
+
+// Runs the daemon in a new mount namespace where `dir` is bind-mounted onto
+// itself (read-only when `read_only`), so it can be remounted from outside
+// with nsenter without touching anybody else's view.
+std::vector<std::string> in_own_mount_namespace(const std::string& dir, bool read_only) {
+  std::string script = "mount --bind '" + dir + "' '" + dir + "'";
+  if (read_only) script += " && mount -o remount,bind,ro '" + dir + "'";
+  return {"unshare", "-m", "--propagation", "private", "sh", "-c", script + " && exec \"$0\" \"$@\""};
+}
+
+bool remount(pid_t pid, const std::string& dir, const char* mode) {
+  const std::string command =
+      "nsenter -t " + std::to_string(pid) + " -m mount -o remount,bind," + mode + " '" + dir + "'";
+  return std::system(command.c_str()) == 0;
+}
+
+calibctl::JsonValue wait_for_end(const VirtualRobotProcess& rig, std::chrono::seconds timeout) {
+  calibctl::JsonValue status;
+  wait_until(
+      [&] {
+        status = rig.ask("status");
+        return status["ok"].boolean() && !status["running"].boolean();
+      },
+      timeout);
+  return status;
+}
+
+bool contains(const std::string& text, const std::string& words) { return text.find(words) != std::string::npos; }
+
+TEST(ReadOnlyStore, ReadOnlyFromTheStartTheRunIsRefusedBeforeAnythingMoves) {
+  if (!mount_namespaces_allowed()) GTEST_SKIP() << "mount namespaces are not allowed here";
+  // GIVEN a daemon whose history directory is mounted read-only
+  VirtualRobotProcess rig;
+  const std::string history = rig.state_dir + "/history";
+  std::filesystem::create_directories(history);
+  auto daemon = rig.start_daemon("daemon", in_own_mount_namespace(history, true));
+  ASSERT_TRUE(wait_until([&] { return rig.answers(); }, 30s)) << daemon->log();
+  std::this_thread::sleep_for(1s);
+  // WHEN a calibration is started
+  ASSERT_TRUE(rig.ask("start")["ok"].boolean());
+  const calibctl::JsonValue status = wait_for_end(rig, 60s);
+  // THEN it fails in preflight, saying the store cannot be written and why
+  EXPECT_EQ(status["state"].string(), "failed");
+  const std::string reason = status["reason"].string();
+  std::printf("reason: %s\n", reason.c_str());
+  EXPECT_TRUE(contains(reason, "the store cannot be written (open " + history +
+                                   "/.write-probe.tmp: Read-only file system)"))
+      << reason;
+  EXPECT_TRUE(contains(reason, "(during preflight)")) << reason;
+  EXPECT_EQ(status["waypoints"].integer(), 0);  // nothing was planned, nothing moved
+}
+
+TEST(ReadOnlyStore, TurningReadOnlyMidRunKeepsTheFitAndCommitRetriesIt) {
+  if (!mount_namespaces_allowed()) GTEST_SKIP() << "mount namespaces are not allowed here";
+  // GIVEN a short run (12 waypoints, the large robot) of a daemon in its own mount namespace
+  VirtualRobotProcess rig("large", 12,
+                          "[validation]\nmin_samples = 10\nmax_anchor_sigma = 1.0\nmax_offset_sigma = 1.0\n");
+  const std::string history = rig.state_dir + "/history";
+  std::filesystem::create_directories(history);
+  auto daemon = rig.start_daemon("daemon", in_own_mount_namespace(history, false));
+  ASSERT_TRUE(wait_until([&] { return rig.answers(); }, 30s)) << daemon->log();
+  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(rig.ask("start")["ok"].boolean());
+  ASSERT_TRUE(wait_until([&] { return rig.ask("status")["waypoint"].integer() >= 2; }, 60s)) << daemon->log();
+  // WHEN the history directory becomes read-only after preflight
+  ASSERT_TRUE(remount(daemon->pid(), history, "ro"));
+  const calibctl::JsonValue status = wait_for_end(rig, 240s);
+  // THEN the run fails at its commit, and the fit and its samples are kept in pending/
+  const std::string reason = status["reason"].string();
+  std::printf("reason: %s\n", reason.c_str());
+  ASSERT_EQ(status["state"].string(), "failed") << reason;
+  EXPECT_TRUE(contains(reason, "Read-only file system")) << reason;
+  EXPECT_TRUE(contains(reason, "samples are kept in " + rig.state_dir + "/pending")) << reason;
+  EXPECT_TRUE(status["pending_commit"].boolean());
+  EXPECT_TRUE(std::filesystem::exists(rig.state_dir + "/pending/calibration.toml"));
+  EXPECT_TRUE(std::filesystem::exists(rig.state_dir + "/pending/samples.csv"));
+  EXPECT_FALSE(std::filesystem::exists(rig.state_dir + "/calibration.toml"));
+
+  // AND WHEN `calibctl commit` is run while it is still read-only THEN it fails and keeps them
+  const std::string calibctl = built_program("tools/calibctl/calibctl");
+  ChildProcess refused({calibctl, "--socket", rig.socket, "commit"}, rig.dir + "/commit-refused.log");
+  EXPECT_EQ(refused.wait_exit(30s), std::optional<int>(1)) << refused.log();
+  EXPECT_TRUE(contains(refused.log(), "failed again")) << refused.log();
+  // AND WHEN the store is writable again THEN `calibctl commit` commits the kept fit
+  ASSERT_TRUE(remount(daemon->pid(), history, "rw"));
+  ChildProcess committed({calibctl, "--socket", rig.socket, "commit"}, rig.dir + "/commit.log");
+  EXPECT_EQ(committed.wait_exit(30s), std::optional<int>(0)) << committed.log();
+  std::printf("calibctl commit: %s", committed.log().c_str());
+  EXPECT_TRUE(rig.ask("show")["present"].boolean());
+  EXPECT_FALSE(std::filesystem::exists(rig.state_dir + "/pending"));
+  EXPECT_FALSE(rig.ask("status")["pending_commit"].boolean());
+}
+
+}  // namespace
+}  // namespace cdpr::integration

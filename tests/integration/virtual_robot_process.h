@@ -1,0 +1,95 @@
+#pragma once
+// The virtual robot as its own process and a cdpr-calibd configuration for
+// it, for the tests that run real daemon processes (kill -9, a read-only
+// store in a mount namespace). The physics runs 20x faster than real time;
+// the daemon settings are the demo's equilibrium settings and, for the
+// small robot, its limits (the reference cable may dip below
+// the planner's 2 N while the small platform swings between waypoints).
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "calibctl/control_client.h"
+#include "calibctl/json_value.h"
+#include "daemon_process.h"
+
+namespace cdpr::integration {
+
+class VirtualRobotProcess {
+ public:
+  // `preset`: "small" or "large"; `waypoint_count` of the plan;
+  // `extra_tables`: more TOML tables appended to the daemon's configuration
+  // (not [store] .. [equilibrium]).
+  explicit VirtualRobotProcess(const std::string& preset = "small", int waypoint_count = 35,
+                               const std::string& extra_tables = "") {
+    using namespace std::chrono_literals;
+    char pattern[] = "/tmp/cdpr-robot-process-XXXXXX";
+    dir = mkdtemp(pattern);
+    socket = dir + "/control";
+    state_dir = dir + "/state";
+    robot_ = std::make_unique<ChildProcess>(
+        std::vector<std::string>{built_program("tools/virtual-robot/virtual-robot"), "--preset", preset, "--seed",
+                                 "1", "--time-scale", "20", "--endpoints", dir + "/robot"},
+        dir + "/robot.log");
+    if (!wait_until([&] { return std::filesystem::exists(dir + "/robot/ready"); }, 60s)) {
+      ADD_FAILURE() << "the virtual robot did not start: " << robot_->log();
+    }
+    config = dir + "/cdpr-calibd.toml";
+    const bool small = preset == "small";
+    std::ofstream(config) << "robot = \"" << dir << "/robot/robot.toml\"\n[store]\nstate_dir = \"" << state_dir
+                          << "\"\n[control]\nsocket = \"" << socket << "\"\n[winches]\nendpoint = \"unix:" << dir
+                          << "/robot/can.sock\"\nheartbeat_timeout_ms = 3000\n[load_cell]\nendpoint = "
+                          << "\"tcp:127.0.0.1:" << ready_value("modbus_port") << "\"\n[pose]\nendpoint = \"unix:"
+                          << dir << "/robot/pose.sock\"\n[button]\nkind = \"none\"\n[limits]\n"
+                          << (small ? "min_tension = 0.5\nmax_tension = 300.0\n" : "")
+                          << "pose_stale_ms = 3000\nsettle_timeout_s = 15.0\n[waypoints]\n"
+                          << (small ? "min_tension = 2.0\nmax_tension = 300.0\nmargin = 1.5\nz_min = 3.0\n"
+                                      "z_max = 18.0\n"
+                                    : "")
+                          << "count = " << waypoint_count << "\n"
+                          << "[equilibrium]\nwindow_s = 1.0\nmax_speed = 0.03\nmax_angular_rate = 0.06\n"
+                          << extra_tables;
+  }
+  ~VirtualRobotProcess() {
+    robot_->signal(SIGTERM);
+    robot_->wait_exit(std::chrono::seconds(30));
+    if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
+  }
+
+  // cdpr-calibd on this configuration, behind `prefix` (e.g. unshare ... --), logging to <dir>/<name>.log.
+  std::unique_ptr<ChildProcess> start_daemon(const std::string& name, std::vector<std::string> prefix = {}) const {
+    prefix.insert(prefix.end(), {built_program("src/cdpr-calibd"), "--config", config});
+    return std::make_unique<ChildProcess>(prefix, dir + "/" + name + ".log");
+  }
+
+  // One request on a fresh connection; a null value when there is no answer.
+  calibctl::JsonValue ask(const std::string& request) const {
+    calibctl::ControlClient client;
+    std::string error, response;
+    if (!client.connect(socket, error) || !client.request(request, response, error, 30'000)) return {};
+    auto value = calibctl::JsonValue::parse(response);
+    return value ? *value : calibctl::JsonValue{};
+  }
+  bool answers() const { return ask("status")["ok"].boolean(); }
+
+  std::string dir, socket, state_dir, config;
+
+ private:
+  std::string ready_value(const std::string& key) const {
+    std::ifstream file(dir + "/robot/ready");
+    std::string line;
+    while (std::getline(file, line)) {
+      if (line.rfind(key + " = ", 0) == 0) return line.substr(key.size() + 3);
+    }
+    return {};
+  }
+
+  std::unique_ptr<ChildProcess> robot_;
+};
+
+}  // namespace cdpr::integration
