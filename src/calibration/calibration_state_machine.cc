@@ -193,10 +193,9 @@ void CalibrationStateMachine::run_plan(hal::TimeUs now_us) {
 void CalibrationStateMachine::run_move(hal::TimeUs now_us) {
   const Waypoint& waypoint = plan_.waypoints[waypoint_index_];
   if (!targets_sent_) {
-    for (int i = 0; i < kCableCount; ++i) {
-      if (const hal::Status s = devices_.winches.set_target_payout(i, waypoint.payout_m[i]); !s.ok()) {
-        return fail("winch " + std::to_string(i) + " target: " + s.to_string(), now_us, true);
-      }
+    // All four together: they start and arrive at the same time.
+    if (const hal::Status s = devices_.winches.set_target_payouts(waypoint.payout_m.data()); !s.ok()) {
+      return fail("winch targets: " + s.to_string(), now_us, true);
     }
     targets_sent_ = true;
     status_.detail = "moving to waypoint " + std::to_string(status_.waypoint);

@@ -20,6 +20,7 @@
 #include "drivers/modbus/modbus_load_cell.h"
 #include "drivers/pose/pose_stream_source.h"
 #include "src/daemon/daemon_loop.h"
+#include "src/winch_bank_config.h"
 #include "virtual-robot/virtual_robot.h"
 
 namespace cdpr::integration {
@@ -52,6 +53,7 @@ inline daemon::DaemonConfig fast_daemon_config(const std::string& dir, const vir
   // a stall of a few hundred ms is the test machine, not a fault under test
   // (the fault tests with injected clocks cover silent nodes and stale poses).
   config.winches.heartbeat_timeout_us = 3'000'000;
+  config.winches.drive.consumer_heartbeat_us = 3'000'000;
   config.calibrator.monitor.pose_stale_us = 3'000'000;
   return config;
 }
@@ -96,13 +98,8 @@ class VirtualRobotRig {
 
     config = fast_daemon_config(dir, *robot);
     if (options.preset == sim::Preset::kSmall) use_small_robot_limits(config);
-    drivers::can::CanWinchBankConfig winch_config;
-    winch_config.heartbeat_timeout_us = config.winches.heartbeat_timeout_us;
-    for (const daemon::WinchNodes& w : config.winches.winches) {
-      winch_config.winches.push_back({w.drive_node_id, w.encoder_node_id, w.encoder_m_per_count, w.drive_m_per_count});
-    }
     winches = std::make_unique<drivers::can::CanopenWinchBank>(
-        winch_config, drivers::can::make_can_connector(config.winches.endpoint));
+        winch_bank_config(config.winches), drivers::can::make_can_connector(config.winches.endpoint));
     drivers::modbus::ModbusLoadCellConfig cell_config;
     cell_config.endpoint = config.load_cell.endpoint;
     load_cell = std::make_unique<drivers::modbus::ModbusLoadCell>(cell_config, clock);

@@ -5,7 +5,8 @@
 //
 //   <dir>/can.sock    CAN frames over a Unix stream socket (the record format
 //                     of drivers/can/fd_can_transport.h): 4 CiA 402 drives and
-//                     4 CiA 406 encoders (canopen_nodes.h)
+//                     4 CiA 406 encoders from their profiles' defaults, which
+//                     the daemon configures over SDO (canopen_nodes.h)
 //   127.0.0.1:<port>  Modbus TCP load cell on the reference cable
 //                     (drivers/modbus/tension_registers.h at address 0)
 //   <dir>/pose.sock   pose stream (drivers/pose/pose_line.h) at pose_rate_hz
