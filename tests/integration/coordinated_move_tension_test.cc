@@ -123,20 +123,13 @@ Excursion drive_through(const sim::TrueRobot& truth, const Eigen::Vector3d& star
 
 TEST(CoordinatedMove, TensionsStayBetweenTheirRestValuesWhenTheWinchesMoveTogether) {
   // GIVEN the large virtual robot of the full calibration and the daemon's plan
-  const virtual_robot::VirtualRobotOptions robot_options = large_robot_acceptance_options();
-  const auto data = sim::simulate_dataset(virtual_robot::dataset_config(robot_options));
-  ASSERT_TRUE(data) << data.error();
-  const sim::TrueRobot& truth = data->true_robot;
-  const Eigen::Vector3d start_world = virtual_robot::start_position_world(robot_options.preset);
-  const auto start = sim::solve_equilibrium(truth, start_world, 0.0);
-  ASSERT_TRUE(start) << start.error().message;
-  std::array<double, kCableCount> encoder_m{};
-  for (int i = 0; i < kCableCount; ++i) encoder_m[i] = start->cables[i].payout_m + truth.encoder_offset_m[i];
-  const auto offsets = calibration::estimate_payout_offsets(data->nominal, start_world, encoder_m);
-  ASSERT_TRUE(offsets) << offsets.error();
-  const calibration::PlannerOptions options = daemon::default_daemon_config().calibrator.planner;
-  const auto plan = calibration::plan_waypoints(data->nominal, *offsets, start_world, options);
+  const auto planned = plan_acceptance_robot(calibration::WaypointSelection::kSpread);
+  ASSERT_TRUE(planned);
+  const calibration::WaypointPlan& plan = planned->plan;
   ASSERT_TRUE(plan.ok()) << plan.problem;
+  const sim::TrueRobot& truth = planned->data.true_robot;
+  const Eigen::Vector3d& start_world = planned->start_world;
+  const calibration::PlannerOptions options = daemon::default_daemon_config().calibrator.planner;
 
   // WHEN it is driven through the first moves with each winch at its own pace, then together
   const Excursion independent = drive_through(truth, start_world, plan.waypoints, false);

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -19,6 +20,9 @@
 #include "drivers/clock/monotonic_clock.h"
 #include "drivers/modbus/modbus_load_cell.h"
 #include "drivers/pose/pose_stream_source.h"
+#include "sim/dataset.h"
+#include "sim/equilibrium.h"
+#include "src/calibration/waypoint_planner.h"
 #include "src/daemon/daemon_loop.h"
 #include "src/winch_bank_config.h"
 #include "virtual-robot/virtual_robot.h"
@@ -82,6 +86,43 @@ inline virtual_robot::VirtualRobotOptions large_robot_acceptance_options() {
   options.time_scale = 20.0;
   options.anchor_perturbation_m = 0.3;
   return options;
+}
+
+// The acceptance robot's true and nominal data and the daemon's plan for it
+// (default planner settings but the selection), made as the daemon makes it
+// at the start position: offsets estimated there, waypoints planned from
+// the nominal anchors. Failures are test failures (check plan.ok()).
+struct PlannedAcceptanceRobot {
+  sim::SimulatedDataset data;
+  Eigen::Vector3d start_world = Eigen::Vector3d::Zero();
+  calibration::WaypointPlan plan;
+};
+
+inline std::optional<PlannedAcceptanceRobot> plan_acceptance_robot(calibration::WaypointSelection selection) {
+  const virtual_robot::VirtualRobotOptions robot_options = large_robot_acceptance_options();
+  auto data = sim::simulate_dataset(virtual_robot::dataset_config(robot_options));
+  if (!data) {
+    ADD_FAILURE() << data.error();
+    return std::nullopt;
+  }
+  const sim::TrueRobot& truth = data->true_robot;
+  const Eigen::Vector3d start_world = virtual_robot::start_position_world(robot_options.preset);
+  const auto start = sim::solve_equilibrium(truth, start_world, 0.0);
+  if (!start) {
+    ADD_FAILURE() << start.error().message;
+    return std::nullopt;
+  }
+  std::array<double, kCableCount> encoder_m{};
+  for (int i = 0; i < kCableCount; ++i) encoder_m[i] = start->cables[i].payout_m + truth.encoder_offset_m[i];
+  const auto offsets = calibration::estimate_payout_offsets(data->nominal, start_world, encoder_m);
+  if (!offsets) {
+    ADD_FAILURE() << offsets.error();
+    return std::nullopt;
+  }
+  calibration::PlannerOptions options = daemon::default_daemon_config().calibrator.planner;
+  options.selection = selection;
+  calibration::WaypointPlan plan = calibration::plan_waypoints(data->nominal, *offsets, start_world, options);
+  return PlannedAcceptanceRobot{std::move(*data), start_world, std::move(plan)};
 }
 
 class VirtualRobotRig {
