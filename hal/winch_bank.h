@@ -103,6 +103,12 @@ class WinchBank {
     return {};
   }
 
+  // The operator's explicit request to clear latched faults (the bank's own,
+  // e.g. a refused configuration, which is then tried again, or an encoder
+  // jump; and a drive's CiA 402 fault, reset once). Nothing resets a fault
+  // without it but enable() at the start of a run.
+  virtual Status reset_faults() { return Status::Ok(); }
+
   // Requests operation enabled on every drive (resets a fault first). Holds
   // the current position: the target is set to the actual position.
   // Watch status().drive == kEnabled. Errors: send failures, kInvalidState.

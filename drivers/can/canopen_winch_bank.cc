@@ -421,6 +421,23 @@ hal::Status CanopenWinchBank::enable() {
   return hal::Status::Ok();
 }
 
+hal::Status CanopenWinchBank::reset_faults() {
+  if (hal::Status s = check_open(); !s.ok()) return s;
+  for (Winch& w : winches_) {
+    w.fault.clear();
+    w.emergency.clear();
+    w.encoder.reset();  // the next reading starts afresh
+    w.encoder_time_us = -1;
+    w.drive.request_fault_reset();
+    for (Node* node : {&w.drive_node, &w.encoder_node}) {
+      if (node->id == 0 || node->configured) continue;
+      node->configurator.cancel();
+      node->configure_at_us = now_us_;  // a refused configuration is tried again
+    }
+  }
+  return poll_drives(now_us_);
+}
+
 hal::Status CanopenWinchBank::disable() { return stop_all(Cia402Drive::Goal::kDisabled); }
 hal::Status CanopenWinchBank::quick_stop() { return stop_all(Cia402Drive::Goal::kQuickStop); }
 

@@ -90,6 +90,7 @@ class CanopenWinchBank final : public hal::WinchBank {
   hal::WinchStatus status(int winch) const override;
   std::string fault_text(int winch) const override;
   hal::WinchBankCounters counters() const override { return counters_; }
+  hal::Status reset_faults() override;
   hal::Status enable() override;
   hal::Status disable() override;
   hal::Status set_target_payout(int winch, double payout_m) override;

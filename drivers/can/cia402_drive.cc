@@ -23,6 +23,11 @@ void Cia402Drive::set_goal(Goal goal) {
   }
 }
 
+void Cia402Drive::request_fault_reset() {
+  if (goal_ == Goal::kNone || goal_ == Goal::kQuickStop) goal_ = Goal::kDisabled;
+  fault_reset_allowed_ = true;
+}
+
 void Cia402Drive::on_status(const DriveTxPdo& pdo) {
   const PowerState before = power_state_;
   has_status_ = true;
@@ -86,6 +91,7 @@ std::uint16_t Cia402Drive::wanted_controlword(bool resend_due) const {
     case Goal::kQuickStop:
       return cia402::kCwQuickStop;  // valid in every state that can move
     case Goal::kDisabled:
+      if (power_state_ == PowerState::kFault && fault_reset_allowed_) break;  // the reset below
       return (power_state_ == PowerState::kQuickStopActive || power_state_ == PowerState::kFault)
                  ? cia402::kCwDisableVoltage
                  : cia402::kCwShutdown;

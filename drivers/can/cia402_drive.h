@@ -31,6 +31,9 @@ class Cia402Drive {
   // fault after the drive was enabled stays latched until the next call.
   void set_goal(Goal goal);
   Goal goal() const { return goal_; }
+  // The operator's request: a drive in fault gets one fault reset (and
+  // stays disabled) whatever the goal.
+  void request_fault_reset();
   // Halt bit (decelerate and hold) while enabled; a new target clears it.
   void set_halt(bool halt) { halt_ = halt; }
 

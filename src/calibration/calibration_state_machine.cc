@@ -64,6 +64,44 @@ bool CalibrationStateMachine::request_start(hal::TimeUs now_us) {
   return true;
 }
 
+bool CalibrationStateMachine::request_reset_faults(hal::TimeUs now_us) {
+  (void)now_us;
+  if (is_running(status_.state)) {
+    status_.note = "reset-faults refused: a calibration is running (abort it first)";
+    return false;
+  }
+  if (const hal::Status s = devices_.winches.reset_faults(); !s.ok()) {
+    status_.note = "reset-faults failed: " + s.to_string();
+    return false;
+  }
+  status_.note = "faults reset" + (status_.device_faults.empty() ? std::string(" (there were none)")
+                                                                  : " (were: " + status_.device_faults + ")");
+  status_.device_faults.clear();
+  return true;
+}
+
+void CalibrationStateMachine::refresh_device_faults() {
+  // Cheap flags first: the texts are built only while a fault is there.
+  bool any = false;
+  for (int i = 0; i < devices_.winches.winch_count(); ++i) {
+    const hal::WinchStatus s = devices_.winches.status(i);
+    any = any || s.fault || s.drive == hal::DriveState::kFault;
+  }
+  if (!any) {
+    if (!status_.device_faults.empty()) status_.device_faults.clear();
+    return;
+  }
+  std::string faults;
+  for (int i = 0; i < devices_.winches.winch_count(); ++i) {
+    const hal::WinchStatus s = devices_.winches.status(i);
+    if (!s.fault && s.drive != hal::DriveState::kFault) continue;
+    const std::string text = devices_.winches.fault_text(i);
+    faults += (faults.empty() ? "" : "; ") + std::string("winch ") + std::to_string(i) + ": " +
+              (text.empty() ? std::string("drive fault") : text);
+  }
+  if (faults != status_.device_faults) status_.device_faults = std::move(faults);
+}
+
 bool CalibrationStateMachine::request_abort(hal::TimeUs now_us, const std::string& why) {
   if (!is_running(status_.state)) {
     status_.note = "abort ignored: no calibration running";
@@ -103,6 +141,7 @@ void CalibrationStateMachine::poll_button(hal::TimeUs now_us) {
 
 void CalibrationStateMachine::step(hal::TimeUs now_us) {
   poll_button(now_us);
+  refresh_device_faults();
   const CalibrationState state = status_.state;
   if (in_motion_phase(state)) {
     if (std::string fault = monitor_.poll(now_us); !fault.empty()) return fail(fault, now_us, true);

@@ -12,16 +12,17 @@ struct Command {
   bool takes_seq;
 };
 
-constexpr std::array<Command, 6> kCommands = {{
+constexpr std::array<Command, 7> kCommands = {{
     {"start", RequestKind::kStart, false},
     {"abort", RequestKind::kAbort, false},
     {"status", RequestKind::kStatus, false},
     {"show", RequestKind::kShow, false},
     {"history", RequestKind::kHistory, false},
     {"rollback", RequestKind::kRollback, true},
+    {"reset-faults", RequestKind::kResetFaults, false},
 }};
 
-constexpr const char* kExpected = "expected start, abort, status, show, history or rollback <seq>";
+constexpr const char* kExpected = "expected start, abort, status, show, history, rollback <seq> or reset-faults";
 
 bool is_blank(char c) { return c == ' ' || c == '\t'; }
 

@@ -12,6 +12,7 @@
 //   show             the current calibration
 //   history          the stored versions
 //   rollback <seq>   make stored version <seq> current again (seq: 1..999999999)
+//   reset-faults     clear the devices' latched faults (not during a run)
 //
 // Every request gets exactly one response line (control_response.h). The
 // parser accepts any byte sequence without crashing and refuses everything
@@ -26,7 +27,7 @@ namespace cdpr::control {
 
 inline constexpr std::size_t kMaxRequestBytes = 256;
 
-enum class RequestKind { kStart, kAbort, kStatus, kShow, kHistory, kRollback };
+enum class RequestKind { kStart, kAbort, kStatus, kShow, kHistory, kRollback, kResetFaults };
 
 const char* to_string(RequestKind kind);
 

@@ -201,6 +201,12 @@ TEST_F(CanopenWinchBankTest, IdentityMismatchRefusesToEnable) {
   run_ms(200);
   EXPECT_FALSE(bus_->drive(0).operation_enabled());
   EXPECT_NE(bank_->status(0).drive, hal::DriveState::kEnabled);
+  // WHEN the operator resets the faults with the cause still there THEN it is tried again and found again
+  ASSERT_TRUE(bank_->reset_faults().ok());
+  EXPECT_FALSE(bank_->status(0).fault);
+  run_ms(200);
+  EXPECT_TRUE(bank_->status(0).fault);
+  EXPECT_NE(bank_->fault_text(0).find("vendor id"), std::string::npos) << bank_->fault_text(0);
 }
 
 TEST_F(CanopenWinchBankTest, RefusedWriteNamesTheAbortCode) {
@@ -255,6 +261,13 @@ TEST_F(CanopenWinchBankTest, EncoderJumpIsALatchedFault) {
   // AND the fault stays latched though the readings are steady again
   run_ms(100);
   EXPECT_TRUE(bank_->status(0).fault);
+  // WHEN the operator resets the faults THEN the position is read afresh and moves are accepted
+  ASSERT_TRUE(bank_->reset_faults().ok());
+  run_ms(50);
+  EXPECT_FALSE(bank_->status(0).fault);
+  EXPECT_TRUE(bank_->status(0).position_valid);
+  EXPECT_EQ(bank_->fault_text(0), "");
+  EXPECT_TRUE(bank_->set_target_payout(0, bank_->status(0).payout_m + 0.1).ok());
 }
 
 TEST_F(CanopenWinchBankTest, MoveLongerThanMaxMoveIsRefused) {
@@ -329,6 +342,12 @@ TEST_F(CanopenWinchBankTest, FollowingErrorIsAFaultWithItsEmergency) {
   // AND the fault stays: nothing resets it behind the operator's back
   run_ms(500);
   EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kFault);
+  // WHEN the operator resets the faults THEN the drive leaves fault but stays disabled
+  ASSERT_TRUE(bank_->quick_stop().ok());  // as the daemon does when a run fails
+  ASSERT_TRUE(bank_->reset_faults().ok());
+  run_ms(150);
+  EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kDisabled);
+  EXPECT_EQ(bank_->fault_text(0), "");
   // WHEN the operator enables again (motor free) THEN the fault is reset once and the drive enabled
   bus_->drive(0).set_blocked(false);
   ASSERT_TRUE(bank_->enable().ok());
