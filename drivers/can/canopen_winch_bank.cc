@@ -79,9 +79,11 @@ CanopenWinchBank::CanopenWinchBank(CanWinchBankConfig config, CanConnector conne
   winches_.reserve(config_.winches.size());
   for (const CanWinchConfig& c : config_.winches) {
     Winch w{Node(c.drive_node_id, config_.sdo_timeout_us), Node(c.encoder_node_id, config_.sdo_timeout_us),
-            Cia402Drive(config_.resend_interval_us), EncoderUnwrap(), -1, 0.0, EnableStep::kNone, false, {}, false, 0, {}, {}};
+            Cia402Drive(config_.resend_interval_us), EncoderUnwrap(), -1, 0.0, EnableStep::kNone, false, {}, false, 0,
+            {}, {}, {}, false, {}};
     w.drive_node.steps = drive_configuration(c.drive_node_id, config_.master_node_id, c.drive_m_per_count, config_.drive);
     if (c.encoder_node_id != 0) w.encoder_node.steps = encoder_configuration(c.encoder_node_id, config_.encoder);
+    w.error_code_steps = {{SdoStep::Kind::kRead, 0x603F, 0, 2, 0, "error code"}};
     w.profile_steps = {{SdoStep::Kind::kWrite, 0x6081, 0, 4, 0, "profile velocity"},
                        {SdoStep::Kind::kWrite, 0x6083, 0, 4, 0, "profile acceleration"},
                        {SdoStep::Kind::kWrite, 0x6084, 0, 4, 0, "profile deceleration"}};
@@ -157,6 +159,7 @@ hal::Status CanopenWinchBank::update(hal::TimeUs now_us) {
       if (hal::Status s = service_node(w, *node, now_us); !s.ok() && first_error.ok()) first_error = s;
     }
     if (hal::Status s = service_enable(w, now_us); !s.ok() && first_error.ok()) first_error = s;
+    if (hal::Status s = service_error_code(w, now_us); !s.ok() && first_error.ok()) first_error = s;
   }
   if (hal::Status s = service_coordinated_move(now_us); !s.ok() && first_error.ok()) first_error = s;
   if (hal::Status s = poll_drives(now_us); !s.ok() && first_error.ok()) first_error = s;
@@ -314,6 +317,31 @@ hal::Status CanopenWinchBank::service_node(Winch& w, Node& node, hal::TimeUs now
       node.configure_at_us = now_us + config_.resend_interval_us;  // not there yet: try again
       break;
     default: break;
+  }
+  return frame ? send(*frame) : hal::Status::Ok();
+}
+
+hal::Status CanopenWinchBank::service_error_code(Winch& w, hal::TimeUs now_us) {
+  if (w.drive.drive_state() != hal::DriveState::kFault) {
+    w.error_code_asked = false;
+    if (!w.error_code.empty()) w.error_code.clear();
+    return hal::Status::Ok();
+  }
+  NodeConfigurator& c = w.drive_node.configurator;
+  if (!w.error_code_asked) {
+    if (!w.drive_node.configured || c.state() == NodeConfigurator::State::kRunning) return hal::Status::Ok();
+    w.error_code_asked = true;
+    c.start(&w.error_code_steps);
+  } else if (c.state() != NodeConfigurator::State::kRunning || !c.runs(&w.error_code_steps)) {
+    return hal::Status::Ok();  // read (or failed) once for this fault, or the channel was taken over
+  }
+  std::optional<CanFrame> frame = c.poll(now_us);
+  if (c.state() == NodeConfigurator::State::kDone) {
+    const std::uint32_t code = c.read_value(0x603F, 0).value_or(0);
+    char text[80];
+    std::snprintf(text, sizeof(text), "0x603F = 0x%04X (%s)", static_cast<unsigned>(code),
+                  emergency_text(static_cast<std::uint16_t>(code)));
+    w.error_code = text;
   }
   return frame ? send(*frame) : hal::Status::Ok();
 }
@@ -557,6 +585,7 @@ std::string CanopenWinchBank::fault_text(int winch) const {
   if (winch < 0 || winch >= winch_count()) std::abort();  // caller's broken invariant (hal/winch_bank.h)
   const Winch& w = winches_[static_cast<std::size_t>(winch)];
   std::string text = w.fault;
+  if (!w.error_code.empty()) text += (text.empty() ? "" : "; ") + w.error_code;
   if (!w.emergency.empty()) text += (text.empty() ? "" : "; last ") + w.emergency;
   return text;
 }

@@ -133,6 +133,9 @@ class CanopenWinchBank final : public hal::WinchBank {
     std::int32_t pending_target_counts = 0;
     std::string fault;  // latched: configuration refused or mismatched, encoder jump
     std::string emergency;  // the latest EMCY of its nodes, for messages
+    std::vector<SdoStep> error_code_steps;  // 0x603F, read once per drive fault
+    bool error_code_asked = false;
+    std::string error_code;  // "0x603F = 0x8611 (following error)" of the present fault
   };
 
   hal::Status send(const CanFrame& frame);
@@ -143,6 +146,8 @@ class CanopenWinchBank final : public hal::WinchBank {
   hal::Status service_node(Winch& winch, Node& node, hal::TimeUs now_us);
   hal::Status service_enable(Winch& winch, hal::TimeUs now_us);
   hal::Status service_coordinated_move(hal::TimeUs now_us);
+  // Reads 0x603F of a drive that entered fault (what EMCY may have missed).
+  hal::Status service_error_code(Winch& winch, hal::TimeUs now_us);
   // The drive target for `payout_target_m`, or why not.
   hal::Result<std::int32_t> target_counts(int winch, double payout_target_m);
   hal::Status send_master_heartbeat(hal::TimeUs now_us);

@@ -42,6 +42,10 @@ class NodeConfigurator {
   std::optional<CanFrame> poll(hal::TimeUs now_us);
 
   State state() const { return state_; }
+  // Whether the present (or last) run is of `steps`: the node's one SDO
+  // channel is shared by configuration, mode check, move profiles and
+  // fault diagnosis, one after the other.
+  bool runs(const std::vector<SdoStep>* steps) const { return steps_ == steps; }
   // Why the run failed (kFailed: a refusal or mismatch; kNoAnswer: timeout).
   const std::string& error() const { return error_; }
   // The value a kRead step read (index:subindex), if it ran.

@@ -339,6 +339,7 @@ TEST_F(CanopenWinchBankTest, FollowingErrorIsAFaultWithItsEmergency) {
   // THEN the drive faults with EMCY 0x8611 and the message says so
   EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kFault);
   EXPECT_NE(bank_->fault_text(0).find("EMCY 0x8611 (following error)"), std::string::npos) << bank_->fault_text(0);
+  EXPECT_NE(bank_->fault_text(0).find("0x603F = 0x8611 (following error)"), std::string::npos) << bank_->fault_text(0);
   // AND the fault stays: nothing resets it behind the operator's back
   run_ms(500);
   EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kFault);
@@ -393,6 +394,30 @@ TEST_F(CanopenWinchBankTest, QuickStopStopsAMovingDrive) {
   EXPECT_DOUBLE_EQ(bank_->status(0).payout_m, stopped_m);
   EXPECT_FALSE(bank_->motion_finished());
   // WHEN enabled again THEN it recovers to operation enabled
+  ASSERT_TRUE(bank_->enable().ok());
+  run_ms(100);
+  EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kEnabled);
+}
+
+TEST_F(CanopenWinchBankTest, QuickStopEndingSwitchedOffIsHandledToo) {
+  // GIVEN drives whose quick stop ends in switch on disabled (0x605A = 2), winch 0 on a long move
+  CanWinchBankConfig config = two_winches();
+  config.drive.quick_stop_option = 2;
+  start(config);
+  open_and_enable();
+  EXPECT_EQ(bus_->drive(0).od().get(0x605A, 0), 2u);
+  ASSERT_TRUE(bank_->set_target_payout(0, bank_->status(0).payout_m + 4.0).ok());
+  run_ms(100);
+  // WHEN quick-stopped
+  ASSERT_TRUE(bank_->quick_stop().ok());
+  run_ms(200);
+  const double stopped_m = bank_->status(0).payout_m;
+  run_ms(200);
+  // THEN the drives are off, nothing moves, and the bank does not fight the ending
+  EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kDisabled);
+  EXPECT_EQ(bus_->drive(0).statusword() & 0x004F, 0x0040);  // switch on disabled
+  EXPECT_DOUBLE_EQ(bank_->status(0).payout_m, stopped_m);
+  // WHEN enabled again THEN it comes back
   ASSERT_TRUE(bank_->enable().ok());
   run_ms(100);
   EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kEnabled);
