@@ -78,6 +78,18 @@ class CanopenWinchBankTest : public ::testing::Test {
     for (int i = 0; i < 2; ++i) ASSERT_EQ(bank_->status(i).drive, hal::DriveState::kEnabled) << "winch " << i;
   }
 
+  // Sends winch 0 4 m (1 s), quick-stops after 100 ms, waits 400 ms;
+  // returns its payout 200 ms after the quick stop.
+  double quick_stop_during_a_long_move() {
+    EXPECT_TRUE(bank_->set_target_payout(0, bank_->status(0).payout_m + 4.0).ok());
+    run_ms(100);
+    EXPECT_TRUE(bank_->quick_stop().ok());
+    run_ms(200);
+    const double stopped_m = bank_->status(0).payout_m;
+    run_ms(200);
+    return stopped_m;
+  }
+
   hal::TimeUs now_us_ = 0;
   std::unique_ptr<test::FakeCanopenBus> bus_;
   std::unique_ptr<CanopenWinchBank> bank_;
@@ -378,16 +390,10 @@ TEST_F(CanopenWinchBankTest, SilentNodeIsDeadAfterHeartbeatTimeout) {
 }
 
 TEST_F(CanopenWinchBankTest, QuickStopStopsAMovingDrive) {
-  // GIVEN winch 0 on a long move (1 s)
+  // GIVEN winch 0 on a long move (1 s) WHEN quick-stopped
   start();
   open_and_enable();
-  ASSERT_TRUE(bank_->set_target_payout(0, bank_->status(0).payout_m + 4.0).ok());
-  run_ms(100);
-  // WHEN quick-stopped
-  ASSERT_TRUE(bank_->quick_stop().ok());
-  run_ms(200);
-  const double stopped_m = bank_->status(0).payout_m;
-  run_ms(200);
+  const double stopped_m = quick_stop_during_a_long_move();
   // THEN both drives are in quick stop and winch 0 did not move on
   EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kQuickStop);
   EXPECT_EQ(bank_->status(1).drive, hal::DriveState::kQuickStop);
@@ -406,13 +412,8 @@ TEST_F(CanopenWinchBankTest, QuickStopEndingSwitchedOffIsHandledToo) {
   start(config);
   open_and_enable();
   EXPECT_EQ(bus_->drive(0).od().get(0x605A, 0), 2u);
-  ASSERT_TRUE(bank_->set_target_payout(0, bank_->status(0).payout_m + 4.0).ok());
-  run_ms(100);
   // WHEN quick-stopped
-  ASSERT_TRUE(bank_->quick_stop().ok());
-  run_ms(200);
-  const double stopped_m = bank_->status(0).payout_m;
-  run_ms(200);
+  const double stopped_m = quick_stop_during_a_long_move();
   // THEN the drives are off, nothing moves, and the bank does not fight the ending
   EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kDisabled);
   EXPECT_EQ(bus_->drive(0).statusword() & 0x004F, 0x0040);  // switch on disabled
