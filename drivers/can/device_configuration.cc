@@ -38,7 +38,11 @@ void pdo(std::vector<SdoStep>& steps, bool transmit, int number, std::uint32_t c
   }
   steps.push_back({Kind::kWriteVerify, map, 0, 1, static_cast<std::uint32_t>(entries.size()), "PDO mapping count"});
   steps.push_back({Kind::kWriteVerify, communication, 2, 1, type, "PDO transmission type"});
-  if (transmit) steps.push_back({Kind::kWriteVerify, communication, 5, 2, event_ms, "TPDO event timer"});
+  if (transmit) {
+    // Changes (a moving position changes every cycle) at most 4 times per event period.
+    steps.push_back({Kind::kWriteVerify, communication, 3, 2, event_ms * 10 / 4, "TPDO inhibit time"});
+    steps.push_back({Kind::kWriteVerify, communication, 5, 2, event_ms, "TPDO event timer"});
+  }
   steps.push_back({Kind::kWriteVerify, communication, 1, 4, cob_id, cob});
 }
 

@@ -6,7 +6,8 @@
 // Drive (CiA 402, profile position):
 //   identity 0x1018:01/02 (when given), RPDO1 = controlword 0x6040 +
 //   target position 0x607A on 0x200 + node, TPDO1 = statusword 0x6041 +
-//   position actual 0x6064 on 0x180 + node (type 255, event timer), PDOs 2-4
+//   position actual 0x6064 on 0x180 + node (type 255, event timer, inhibit
+//   time a quarter of it so a moving position is not sent every cycle), PDOs 2-4
 //   invalid; 0x605A, 0x6007, 0x6065, 0x607D, 0x6081, 0x6083, 0x6084, 0x6085;
 //   heartbeat producer 0x1017 and consumer 0x1016:01 of the master.
 //   Before every enable: 0x6060 = 1 written, 0x6061 = 1 checked.

@@ -301,11 +301,15 @@ void CanopenDevice::send_tpdos(hal::TimeUs now_us, bool sync) {
       due = sync && changed;
     } else if (type >= 254) {
       const bool timer_due = event_us > 0 && (tpdo_next_event_us_[n] < 0 || now_us >= tpdo_next_event_us_[n]);
-      due = changed || timer_due;
+      // A change is sent no sooner than the inhibit time (0x1800:03, 100 us units) after the last frame.
+      const hal::TimeUs inhibit_us = 100 * static_cast<hal::TimeUs>(od_.get(comm, 3));
+      const bool inhibited = tpdo_sent_[n] && now_us - tpdo_last_us_[n] < inhibit_us;
+      due = timer_due || (changed && !inhibited);
     }
     if (!due) continue;
     if (event_us > 0) tpdo_next_event_us_[n] = now_us + event_us;
     tpdo_last_[n] = frame;
+    tpdo_last_us_[n] = now_us;
     tpdo_sent_[n] = true;
     outbox_.push_back(frame);
   }

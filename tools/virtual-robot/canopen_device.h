@@ -11,7 +11,8 @@
 // monitoring starts with the first heartbeat heard, a timeout is an EMCY
 // 0x8130 and the profile's reaction); four RPDOs and four TPDOs per their
 // communication and mapping parameters (TPDOs: transmission type 1-240 on
-// every n-th SYNC, 254/255 on change of their data and on the event timer);
+// every n-th SYNC, 254/255 on the event timer and on change of their data,
+// a change no sooner than the inhibit time 0x1800:03 after the last frame);
 // EMCY (0x80 + node) with the error register 0x1001.
 //
 // No code shared with the master (drivers/can): the frame type is this
@@ -130,6 +131,7 @@ class CanopenDevice {
   std::array<hal::TimeUs, 4> tpdo_next_event_us_{-1, -1, -1, -1};
   std::array<BusFrame, 4> tpdo_last_{};
   std::array<bool, 4> tpdo_sent_{};
+  std::array<hal::TimeUs, 4> tpdo_last_us_{};
   int sync_count_ = 0;
   bool sync_pending_ = false;
   hal::TimeUs consumer_last_us_ = -1;  // last heartbeat of the 0x1016:01 producer; -1: not armed
