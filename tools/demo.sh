@@ -61,6 +61,8 @@ state_dir = "$work/state"
 socket = "$work/control"
 [winches]
 endpoint = "unix:$work/robot/can.sock"
+# The physics runs 20x faster: a 2 m/s cable pays out 40 m per real second.
+max_speed_mps = 100.0
 [load_cell]
 endpoint = "tcp:127.0.0.1:$modbus_port"
 [pose]

@@ -57,6 +57,8 @@ inline daemon::DaemonConfig fast_daemon_config(const std::string& dir, const vir
   // a stall of a few hundred ms is the test machine, not a fault under test
   // (the fault tests with injected clocks cover silent nodes and stale poses).
   config.winches.heartbeat_timeout_us = 3'000'000;
+  // Simulated time runs faster: a 2 m/s cable pays out 2 x time_scale m per real second.
+  config.winches.max_speed_mps = 5.0 * robot.time_scale();
   config.winches.drive.consumer_heartbeat_us = 3'000'000;
   config.calibrator.monitor.pose_stale_us = 3'000'000;
   return config;

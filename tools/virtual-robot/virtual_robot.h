@@ -75,6 +75,7 @@ class VirtualRobot {
   std::string can_endpoint() const { return "unix:" + options_.dir + "/can.sock"; }
   std::string pose_endpoint() const { return "unix:" + options_.dir + "/pose.sock"; }
   std::string modbus_endpoint() const { return "tcp:127.0.0.1:" + std::to_string(modbus_->port()); }
+  double time_scale() const { return options_.time_scale; }
   const Robot& nominal_robot() const { return data_.nominal; }
   const Truth& truth() const { return data_.truth; }
   const RobotPhysics& physics() const { return *physics_; }
