@@ -25,6 +25,7 @@
 // error) and do not allocate when ok. open() may block for the connect.
 
 #include <cstdint>
+#include <string>
 
 #include "hal/clock.h"
 #include "hal/status.h"
@@ -60,6 +61,7 @@ struct WinchStatus {
   TimeUs heartbeat_age_us = -1;   // now - oldest last heartbeat of its nodes [us]; -1: never heard
   DriveState drive = DriveState::kUnknown;
   bool target_reached = false;    // drive reports the latest target reached (and acknowledged)
+  bool fault = false;             // a fault latched by the bank (fault_text() says which)
 };
 
 // Bus counters for diagnostics (PX4-style perf counters, no log per frame).
@@ -94,6 +96,18 @@ class WinchBank {
   // is a broken invariant of the caller).
   virtual WinchStatus status(int winch) const = 0;
   virtual WinchBankCounters counters() const = 0;
+  // What the latched fault of one winch is (node, object, values), empty
+  // when none. Allocates: for messages, not for the cyclic path.
+  virtual std::string fault_text(int winch) const {
+    (void)winch;
+    return {};
+  }
+
+  // The operator's explicit request to clear latched faults (the bank's own,
+  // e.g. a refused configuration, which is then tried again, or an encoder
+  // jump; and a drive's CiA 402 fault, reset once). Nothing resets a fault
+  // without it but enable() at the start of a run.
+  virtual Status reset_faults() { return Status::Ok(); }
 
   // Requests operation enabled on every drive (resets a fault first). Holds
   // the current position: the target is set to the actual position.
@@ -106,6 +120,16 @@ class WinchBank {
   // its configured profile speed. Errors: kInvalidArgument (bad index,
   // non-finite), kInvalidState (drive not kEnabled or node dead), send failure.
   virtual Status set_target_payout(int winch, double payout_m) = 0;
+  // Commands new targets for all winches at once (payouts_m[0 ..
+  // winch_count() - 1]) so that they start and arrive together (a cable
+  // robot's cables go slack or overload when one winch runs ahead).
+  // Default: set_target_payout() for each, for banks without coordination.
+  virtual Status set_target_payouts(const double* payouts_m) {
+    for (int i = 0; i < winch_count(); ++i) {
+      if (Status s = set_target_payout(i, payouts_m[i]); !s.ok()) return s;
+    }
+    return Status::Ok();
+  }
   // Decelerates every winch to rest and holds, staying enabled (CiA 402 halt
   // bit); a later set_target_payout() clears it.
   virtual Status halt() = 0;

@@ -34,6 +34,7 @@
 #include "src/daemon/daemon_loop.h"
 #include "src/daemon/instance_lock.h"
 #include "src/formats/robot_toml.h"
+#include "src/winch_bank_config.h"
 
 namespace {
 
@@ -70,16 +71,6 @@ class SdNotifier final : public daemon::ServiceNotifier {
   hal::TimeUs ping_interval_us_ = 0;  // 0: no watchdog configured
   hal::TimeUs last_ping_us_ = 0;
 };
-
-drivers::can::CanWinchBankConfig winch_bank_config(const daemon::WinchesConfig& c) {
-  drivers::can::CanWinchBankConfig out;
-  out.heartbeat_timeout_us = c.heartbeat_timeout_us;
-  out.resend_interval_us = c.resend_interval_us;
-  for (const daemon::WinchNodes& w : c.winches) {
-    out.winches.push_back({w.drive_node_id, w.encoder_node_id, w.encoder_m_per_count, w.drive_m_per_count});
-  }
-  return out;
-}
 
 std::unique_ptr<hal::Button> open_button(const daemon::ButtonConfig& c) {
   if (!c.gpio) return nullptr;

@@ -62,6 +62,8 @@ state_dir = "$work/state"
 socket = "$work/control"
 [winches]
 endpoint = "unix:$work/robot/can.sock"
+# The physics runs 20x faster: a 2 m/s cable pays out 40 m per real second.
+max_speed_mps = 100.0
 [load_cell]
 # The virtual FT-11 shows kilograms with two decimals.
 endpoint = "rtu:$work/robot/load_cell.tty"

@@ -17,11 +17,13 @@ std::uint16_t get_u16(const CanFrame& frame, int at) {
   return static_cast<std::uint16_t>(frame.data[at] | (frame.data[at + 1] << 8));
 }
 
-std::int32_t get_i32(const CanFrame& frame, int at) {
+std::uint32_t get_u32(const CanFrame& frame, int at) {
   std::uint32_t bits = 0;
   for (int i = 0; i < 4; ++i) bits |= static_cast<std::uint32_t>(frame.data[at + i]) << (8 * i);
-  return static_cast<std::int32_t>(bits);
+  return bits;
 }
+
+std::int32_t get_i32(const CanFrame& frame, int at) { return static_cast<std::int32_t>(get_u32(frame, at)); }
 
 CanFrame frame_of(std::uint32_t id, std::uint8_t len) {
   CanFrame frame;
@@ -50,9 +52,9 @@ CanFrame make_heartbeat(int node_id, NmtState state) {
   return frame;
 }
 
-CanFrame make_encoder_tpdo(int node_id, std::int32_t position_counts) {
+CanFrame make_encoder_tpdo(int node_id, std::uint32_t position_counts) {
   CanFrame frame = frame_of(kTpdo1Base + static_cast<std::uint32_t>(node_id), 4);
-  put_i32(frame, 0, position_counts);
+  put_i32(frame, 0, static_cast<std::int32_t>(position_counts));
   return frame;
 }
 
@@ -68,6 +70,34 @@ CanFrame make_drive_rxpdo(int node_id, std::uint16_t controlword, std::int32_t t
   put_u16(frame, 0, controlword);
   put_i32(frame, 2, target_counts);
   return frame;
+}
+
+const char* emergency_text(std::uint16_t code) {
+  switch (code) {
+    case 0x0000: return "error reset";
+    case 0x8110: return "CAN overrun";
+    case 0x8120: return "CAN error passive";
+    case 0x8130: return "life guard or heartbeat error";
+    case 0x8140: return "recovered from bus off";
+    case 0x8210: return "PDO not processed: length error";
+    case 0x8220: return "PDO length exceeded";
+    case 0x8611: return "following error";
+    case 0x8612: return "reference limit";
+    default: break;
+  }
+  switch (code >> 12) {
+    case 0x1: return "generic error";
+    case 0x2: return "current";
+    case 0x3: return "voltage";
+    case 0x4: return "temperature";
+    case 0x5: return "device hardware";
+    case 0x6: return "device software";
+    case 0x7: return "additional modules";
+    case 0x8: return "monitoring";
+    case 0x9: return "external error";
+    case 0xF: return code >= 0xFF00 ? "device specific" : "additional functions";
+    default: return "unknown error code";
+  }
 }
 
 std::optional<NmtCommandFrame> parse_nmt(const CanFrame& frame) {
@@ -95,9 +125,9 @@ std::optional<NmtState> parse_heartbeat(const CanFrame& frame) {
   return std::nullopt;
 }
 
-std::optional<std::int32_t> parse_encoder_tpdo(const CanFrame& frame) {
+std::optional<std::uint32_t> parse_encoder_tpdo(const CanFrame& frame) {
   if (frame.len < 4) return std::nullopt;
-  return get_i32(frame, 0);
+  return get_u32(frame, 0);
 }
 
 std::optional<DriveTxPdo> parse_drive_txpdo(const CanFrame& frame) {

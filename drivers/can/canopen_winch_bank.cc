@@ -1,8 +1,9 @@
 #include "drivers/can/canopen_winch_bank.h"
 
 #include <algorithm>
-#include <cstdlib>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <utility>
 
@@ -57,16 +58,35 @@ std::string validate(const CanWinchBankConfig& config) {
   if (config.heartbeat_timeout_us <= 0 || config.resend_interval_us <= 0 || config.max_frames_per_update <= 0) {
     return "heartbeat timeout, resend interval and frames per update must be positive";
   }
+  if (!(config.max_move_m > 0.0) || !(config.max_speed_mps > 0.0)) return "max_move and max_speed must be positive";
+  if (!valid_node_id(config.master_node_id)) return "master node id out of 1..127";
+  for (const CanWinchConfig& w : config.winches) {
+    if (w.drive_node_id == config.master_node_id || w.encoder_node_id == config.master_node_id) {
+      return "master node id " + std::to_string(config.master_node_id) + " also used by a winch node";
+    }
+  }
+  if (config.master_heartbeat_us <= 0 || config.sdo_timeout_us <= 0) return "master heartbeat and SDO timeout must be positive";
+  if (config.drive.consumer_heartbeat_us <= config.master_heartbeat_us) {
+    return "the drives' consumer heartbeat time must exceed the master's heartbeat period";
+  }
+  if (std::string problem = validate(config.drive); !problem.empty()) return "drive: " + problem;
+  if (std::string problem = validate(config.encoder); !problem.empty()) return "encoder: " + problem;
   return {};
 }
 
 CanopenWinchBank::CanopenWinchBank(CanWinchBankConfig config, CanConnector connector)
-    : config_(std::move(config)), connector_(std::move(connector)) {
+    : config_(std::move(config)), connector_(std::move(connector)), mode_steps_(drive_mode_check()) {
   winches_.reserve(config_.winches.size());
   for (const CanWinchConfig& c : config_.winches) {
-    Winch w{Node{}, Node{}, Cia402Drive(config_.resend_interval_us)};
-    w.drive_node.id = c.drive_node_id;
-    w.encoder_node.id = c.encoder_node_id;
+    Winch w{Node(c.drive_node_id, config_.sdo_timeout_us), Node(c.encoder_node_id, config_.sdo_timeout_us),
+            Cia402Drive(config_.resend_interval_us), EncoderUnwrap(), -1, 0.0, EnableStep::kNone, false, {}, false, 0,
+            {}, {}, {}, false, {}};
+    w.drive_node.steps = drive_configuration(c.drive_node_id, config_.master_node_id, c.drive_m_per_count, config_.drive);
+    if (c.encoder_node_id != 0) w.encoder_node.steps = encoder_configuration(c.encoder_node_id, config_.encoder);
+    w.error_code_steps = {{SdoStep::Kind::kRead, 0x603F, 0, 2, 0, "error code"}};
+    w.profile_steps = {{SdoStep::Kind::kWrite, 0x6081, 0, 4, 0, "profile velocity"},
+                       {SdoStep::Kind::kWrite, 0x6083, 0, 4, 0, "profile acceleration"},
+                       {SdoStep::Kind::kWrite, 0x6084, 0, 4, 0, "profile deceleration"}};
     winches_.push_back(std::move(w));
   }
 }
@@ -83,24 +103,25 @@ hal::Status CanopenWinchBank::open() {
   auto transport = connector_();
   if (!transport.ok()) return transport.status();
   transport_ = std::move(transport.value());
+  last_master_heartbeat_us_ = -1;
   for (Winch& w : winches_) {
     w.drive.reset();
-    w.encoder_valid = false;
+    w.drive.set_goal(Cia402Drive::Goal::kNone);
+    w.encoder.reset();
+    w.encoder_time_us = -1;
+    w.enable = EnableStep::kNone;
+    w.fault.clear();
     for (Node* node : {&w.drive_node, &w.encoder_node}) {
       node->last_heartbeat_us = -1;
-      node->start_wanted = node->id != 0;
+      node->last_pdo_us = -1;
+      node->configured = false;
+      node->configurator.cancel();
+      node->configure_at_us = node->id != 0 ? now_us_ : -1;
       node->last_start_sent_us = -1;
     }
   }
-  // Start the nodes now (retried from update() until their heartbeat says
-  // operational).
-  for (Winch& w : winches_) {
-    for (Node* node : {&w.drive_node, &w.encoder_node}) {
-      if (node->id == 0) continue;
-      if (hal::Status s = service_node(*node, now_us_); !s.ok()) return s;
-    }
-  }
-  return hal::Status::Ok();
+  // Configuration starts from update(), one SDO frame per node per call.
+  return send_master_heartbeat(now_us_);
 }
 
 void CanopenWinchBank::close() { transport_.reset(); }
@@ -131,77 +152,227 @@ hal::Status CanopenWinchBank::update(hal::TimeUs now_us) {
     ++counters_.frames_rx;
     dispatch(frame, now_us);
   }
-  hal::Status first_error;
+  hal::Status first_error = send_master_heartbeat(now_us);
   for (Winch& w : winches_) {
     for (Node* node : {&w.drive_node, &w.encoder_node}) {
       if (node->id == 0) continue;
-      if (hal::Status s = service_node(*node, now_us); !s.ok() && first_error.ok()) first_error = s;
+      if (hal::Status s = service_node(w, *node, now_us); !s.ok() && first_error.ok()) first_error = s;
     }
+    if (hal::Status s = service_enable(w, now_us); !s.ok() && first_error.ok()) first_error = s;
+    if (hal::Status s = service_error_code(w, now_us); !s.ok() && first_error.ok()) first_error = s;
   }
+  if (hal::Status s = service_coordinated_move(now_us); !s.ok() && first_error.ok()) first_error = s;
   if (hal::Status s = poll_drives(now_us); !s.ok() && first_error.ok()) first_error = s;
   return first_error;
 }
 
+hal::Status CanopenWinchBank::send_master_heartbeat(hal::TimeUs now_us) {
+  if (last_master_heartbeat_us_ >= 0 && now_us - last_master_heartbeat_us_ < config_.master_heartbeat_us) {
+    return hal::Status::Ok();
+  }
+  last_master_heartbeat_us_ = now_us;
+  return send(make_heartbeat(config_.master_node_id, NmtState::kOperational));
+}
+
 void CanopenWinchBank::dispatch(const CanFrame& frame, hal::TimeUs now_us) {
   for (Winch& w : winches_) {
-    if (auto node = node_of(frame, kHeartbeatBase)) {
-      Node* target = *node == w.drive_node.id ? &w.drive_node : *node == w.encoder_node.id ? &w.encoder_node : nullptr;
-      if (target == nullptr) continue;
-      if (auto state = parse_heartbeat(frame)) {
-        on_heartbeat(w, *target, *state, now_us);
+    for (Node* node : {&w.drive_node, &w.encoder_node}) {
+      if (node->id == 0) continue;
+      const auto id = static_cast<std::uint32_t>(node->id);
+      if (frame.id == kSdoResponseBase + id) {
+        (void)node->configurator.on_frame(frame, now_us);
+        return;
+      }
+      if (frame.id == kEmergencyBase + id) {
+        on_emergency(w, *node, frame);
+        return;
+      }
+      if (frame.id == kHeartbeatBase + id) {
+        if (auto state = parse_heartbeat(frame)) {
+          on_heartbeat(w, *node, *state, now_us);
+        } else {
+          ++counters_.errors;
+        }
+        return;
+      }
+      if (frame.id != kTpdo1Base + id) continue;
+      // PDOs flow only in operational (CiA 301): the NMT start took effect
+      // even if the heartbeat saying so is still to come.
+      node->nmt_state = NmtState::kOperational;
+      if (node == &w.drive_node) {
+        if (auto pdo = parse_drive_txpdo(frame)) {
+          node->last_pdo_us = now_us;
+          w.drive.on_status(*pdo);
+          if (w.encoder_node.id == 0) on_position(w, static_cast<std::uint32_t>(pdo->actual_counts), now_us);
+        } else {
+          ++counters_.errors;
+        }
+      } else if (auto counts = parse_encoder_tpdo(frame)) {
+        node->last_pdo_us = now_us;
+        on_position(w, *counts, now_us);
       } else {
         ++counters_.errors;
       }
       return;
     }
-    if (auto node = node_of(frame, kTpdo1Base)) {
-      if (*node == w.drive_node.id) {
-        if (auto pdo = parse_drive_txpdo(frame)) {
-          w.drive.on_status(*pdo);
-          if (w.encoder_node.id == 0) {
-            w.encoder_counts = pdo->actual_counts;
-            w.encoder_valid = true;
-            w.encoder_time_us = now_us;
-          }
-        } else {
-          ++counters_.errors;
-        }
-        return;
-      }
-      if (*node == w.encoder_node.id) {
-        if (auto counts = parse_encoder_tpdo(frame)) {
-          w.encoder_counts = *counts;
-          w.encoder_valid = true;
-          w.encoder_time_us = now_us;
-        } else {
-          ++counters_.errors;
-        }
-        return;
-      }
-    }
   }
-  ++counters_.frames_ignored;  // our own RxPDOs echoed, other nodes, SYNC, EMCY, ...
+  ++counters_.frames_ignored;  // our own frames echoed, other nodes, SYNC, ...
+}
+
+void CanopenWinchBank::on_emergency(Winch& w, const Node& node, const CanFrame& frame) {
+  if (frame.len < 3) {
+    ++counters_.errors;
+    return;
+  }
+  const auto code = static_cast<std::uint16_t>(frame.data[0] | frame.data[1] << 8);
+  if (code == 0) return;  // error reset: the cause stays in the message until the next EMCY
+  char text[96];
+  std::snprintf(text, sizeof(text), "EMCY 0x%04X (%s), error register 0x%02X from node %d", code,
+                emergency_text(code), frame.data[2], node.id);
+  w.emergency = text;
+}
+
+void CanopenWinchBank::on_position(Winch& w, std::uint32_t raw, hal::TimeUs now_us) {
+  const std::size_t i = static_cast<std::size_t>(&w - winches_.data());
+  const CanWinchConfig& c = config_.winches[i];
+  const double m_per_count = std::abs(c.encoder_node_id == 0 ? c.drive_m_per_count : c.encoder_m_per_count);
+  // Readings queued together arrive with one receive time: allow the change
+  // of one heartbeat timeout on top of the time between them.
+  const hal::TimeUs since_us = w.encoder_time_us < 0 ? 0 : now_us - w.encoder_time_us;
+  const double max_change_counts =
+      config_.max_speed_mps * 1e-6 * static_cast<double>(since_us + config_.heartbeat_timeout_us) / m_per_count;
+  switch (w.encoder.add(raw, max_change_counts)) {
+    case EncoderUnwrap::Outcome::kOk:
+      w.encoder_time_us = now_us;
+      return;
+    case EncoderUnwrap::Outcome::kOutOfRange:
+      ++counters_.errors;
+      if (w.fault.empty()) {
+        w.fault = "node " + std::to_string(c.encoder_node_id != 0 ? c.encoder_node_id : c.drive_node_id) + ": position " + std::to_string(raw) + " outside the measuring range of " +
+                  std::to_string(w.encoder.range()) + " counts";
+      }
+      return;
+    case EncoderUnwrap::Outcome::kJump:
+      if (w.fault.empty()) {
+        w.fault = "node " + std::to_string(c.encoder_node_id != 0 ? c.encoder_node_id : c.drive_node_id) + ": position jumped by " + std::to_string(w.encoder.last_jump_counts()) + " counts (" +
+                  std::to_string(static_cast<double>(w.encoder.last_jump_counts()) * m_per_count) +
+                  " m) between two readings, more than " + std::to_string(config_.max_speed_mps) + " m/s allows";
+      }
+      return;
+  }
 }
 
 void CanopenWinchBank::on_heartbeat(Winch& winch, Node& node, NmtState state, hal::TimeUs now_us) {
   node.last_heartbeat_us = now_us;
-  if (state == NmtState::kBootUp && &node == &winch.drive_node) {
-    // Rebooted: forget what it said, and do not re-enable it behind the
-    // daemon's back: it stays disabled until enable() is called again.
+  node.nmt_state = state;
+  if (state != NmtState::kBootUp) return;
+  // Rebooted: its dictionary is back at the defaults, so configure it
+  // again; and do not re-enable it behind the daemon's back: it stays
+  // disabled until enable() is called again.
+  node.configured = false;
+  node.configurator.cancel();
+  node.configure_at_us = now_us;
+  node.last_pdo_us = -1;
+  if (&node == &winch.drive_node) {
     winch.drive.reset();
     winch.drive.set_goal(Cia402Drive::Goal::kNone);
+    winch.enable = EnableStep::kNone;
+  } else {
+    winch.encoder.reset();
   }
-  node.nmt_state = state;
-  node.start_wanted = state != NmtState::kOperational;
 }
 
-hal::Status CanopenWinchBank::service_node(Node& node, hal::TimeUs now_us) {
-  if (!node.start_wanted) return hal::Status::Ok();
-  if (node.last_start_sent_us >= 0 && now_us - node.last_start_sent_us < config_.resend_interval_us) {
+hal::Status CanopenWinchBank::service_node(Winch& w, Node& node, hal::TimeUs now_us) {
+  if (node.configured) {
+    // Configured: keep it operational (NMT start, rate-limited).
+    if (node.nmt_state == NmtState::kOperational || node.last_heartbeat_us < 0) return hal::Status::Ok();
+    if (node.last_start_sent_us >= 0 && now_us - node.last_start_sent_us < config_.resend_interval_us) {
+      return hal::Status::Ok();
+    }
+    node.last_start_sent_us = now_us;
+    return send(make_nmt(NmtCommand::kStart, node.id));
+  }
+  NodeConfigurator& c = node.configurator;
+  if (c.state() != NodeConfigurator::State::kRunning) {
+    if (node.configure_at_us < 0 || now_us < node.configure_at_us) return hal::Status::Ok();
+    node.configure_at_us = -1;
+    // PDO parameters change only in pre-operational.
+    if (hal::Status s = send(make_nmt(NmtCommand::kEnterPreOperational, node.id)); !s.ok()) return s;
+    c.start(&node.steps);
+  }
+  std::optional<CanFrame> frame = c.poll(now_us);
+  switch (c.state()) {
+    case NodeConfigurator::State::kDone:
+      node.configured = true;
+      if (&node == &w.encoder_node) {
+        w.encoder.set_range(c.read_value(0x6002, 0).value_or(0));
+      }
+      node.last_start_sent_us = now_us;
+      if (frame) (void)send(*frame);
+      return send(make_nmt(NmtCommand::kStart, node.id));
+    case NodeConfigurator::State::kFailed:
+      if (w.fault.empty()) w.fault = "configuration refused: " + c.error();
+      break;
+    case NodeConfigurator::State::kNoAnswer:
+      node.configure_at_us = now_us + config_.resend_interval_us;  // not there yet: try again
+      break;
+    default: break;
+  }
+  return frame ? send(*frame) : hal::Status::Ok();
+}
+
+hal::Status CanopenWinchBank::service_error_code(Winch& w, hal::TimeUs now_us) {
+  if (w.drive.drive_state() != hal::DriveState::kFault) {
+    w.error_code_asked = false;
+    if (!w.error_code.empty()) w.error_code.clear();
     return hal::Status::Ok();
   }
-  node.last_start_sent_us = now_us;
-  return send(make_nmt(NmtCommand::kStart, node.id));
+  NodeConfigurator& c = w.drive_node.configurator;
+  if (!w.error_code_asked) {
+    if (!w.drive_node.configured || c.state() == NodeConfigurator::State::kRunning) return hal::Status::Ok();
+    w.error_code_asked = true;
+    c.start(&w.error_code_steps);
+  } else if (c.state() != NodeConfigurator::State::kRunning || !c.runs(&w.error_code_steps)) {
+    return hal::Status::Ok();  // read (or failed) once for this fault, or the channel was taken over
+  }
+  std::optional<CanFrame> frame = c.poll(now_us);
+  if (c.state() == NodeConfigurator::State::kDone) {
+    const std::uint32_t code = c.read_value(0x603F, 0).value_or(0);
+    char text[80];
+    std::snprintf(text, sizeof(text), "0x603F = 0x%04X (%s)", static_cast<unsigned>(code),
+                  emergency_text(static_cast<std::uint16_t>(code)));
+    w.error_code = text;
+  }
+  return frame ? send(*frame) : hal::Status::Ok();
+}
+
+hal::Status CanopenWinchBank::service_enable(Winch& w, hal::TimeUs now_us) {
+  if (w.enable != EnableStep::kCheckMode || !w.drive_node.configured) return hal::Status::Ok();
+  if (!w.fault.empty()) {
+    w.enable = EnableStep::kNone;
+    return hal::Status::Ok();
+  }
+  NodeConfigurator& c = w.drive_node.configurator;
+  if (!w.mode_check_started) {
+    w.mode_check_started = true;
+    c.start(&mode_steps_);
+  }
+  std::optional<CanFrame> frame = c.poll(now_us);
+  switch (c.state()) {
+    case NodeConfigurator::State::kDone:
+      w.enable = EnableStep::kGoalSet;
+      w.drive.set_goal(Cia402Drive::Goal::kEnabled);
+      break;
+    case NodeConfigurator::State::kFailed:
+      w.fault = "enable refused: " + c.error();
+      w.enable = EnableStep::kNone;
+      break;
+    case NodeConfigurator::State::kNoAnswer:
+      w.mode_check_started = false;  // try again
+      break;
+    default: break;
+  }
+  return frame ? send(*frame) : hal::Status::Ok();
 }
 
 hal::Status CanopenWinchBank::poll_drives(hal::TimeUs now_us) {
@@ -216,14 +387,18 @@ hal::Status CanopenWinchBank::poll_drives(hal::TimeUs now_us) {
 }
 
 bool CanopenWinchBank::node_alive(const Node& node) const {
-  return node.id == 0 || (node.last_heartbeat_us >= 0 && now_us_ - node.last_heartbeat_us <= config_.heartbeat_timeout_us);
+  if (node.id == 0) return true;
+  const bool heartbeat_fresh =
+      node.last_heartbeat_us >= 0 && now_us_ - node.last_heartbeat_us <= config_.heartbeat_timeout_us;
+  const bool pdo_fresh = node.last_pdo_us >= 0 && now_us_ - node.last_pdo_us <= config_.heartbeat_timeout_us;
+  return node.configured && heartbeat_fresh && node.nmt_state == NmtState::kOperational && pdo_fresh;
 }
 
 double CanopenWinchBank::payout_m(const Winch& w) const {
   const std::size_t i = static_cast<std::size_t>(&w - winches_.data());
   const CanWinchConfig& c = config_.winches[i];
   const double m_per_count = c.encoder_node_id == 0 ? c.drive_m_per_count : c.encoder_m_per_count;
-  return static_cast<double>(w.encoder_counts) * m_per_count;
+  return static_cast<double>(w.encoder.counts()) * m_per_count;
 }
 
 hal::WinchStatus CanopenWinchBank::status(int winch) const {
@@ -231,14 +406,16 @@ hal::WinchStatus CanopenWinchBank::status(int winch) const {
   const Winch& w = winches_[static_cast<std::size_t>(winch)];
   hal::WinchStatus s;
   s.payout_m = payout_m(w);
-  s.position_valid = w.encoder_valid;
+  s.position_valid = w.encoder.valid();
+  s.fault = !w.fault.empty();
   s.position_time_us = w.encoder_time_us;
   s.target_payout_m = w.target_payout_m;
   hal::TimeUs oldest_us = std::numeric_limits<hal::TimeUs>::max();
   bool heard_all = true;
   for (const Node* node : {&w.drive_node, &w.encoder_node}) {
     if (node->id == 0) continue;
-    heard_all = heard_all && node->last_heartbeat_us >= 0;
+    // Until configured a node is not there yet for the caller (hal's -1 age).
+    heard_all = heard_all && node->configured && node->last_heartbeat_us >= 0 && node->last_pdo_us >= 0;
     oldest_us = std::min(oldest_us, node->last_heartbeat_us);
   }
   s.heartbeat_age_us = heard_all ? now_us_ - oldest_us : -1;
@@ -248,23 +425,66 @@ hal::WinchStatus CanopenWinchBank::status(int winch) const {
   return s;
 }
 
-hal::Status CanopenWinchBank::set_goal_all(Cia402Drive::Goal goal) {
+hal::Status CanopenWinchBank::stop_all(Cia402Drive::Goal goal) {
   if (hal::Status s = check_open(); !s.ok()) return s;
-  for (Winch& w : winches_) w.drive.set_goal(goal);
+  cancel_coordinated_move();
+  for (Winch& w : winches_) {
+    w.enable = EnableStep::kNone;
+    w.drive.set_goal(goal);
+  }
   return poll_drives(now_us_);
 }
 
-hal::Status CanopenWinchBank::enable() { return set_goal_all(Cia402Drive::Goal::kEnabled); }
-hal::Status CanopenWinchBank::disable() { return set_goal_all(Cia402Drive::Goal::kDisabled); }
-hal::Status CanopenWinchBank::quick_stop() { return set_goal_all(Cia402Drive::Goal::kQuickStop); }
+hal::Status CanopenWinchBank::enable() {
+  if (hal::Status s = check_open(); !s.ok()) return s;
+  // The goal is set once the drive's mode is written and checked (update()).
+  for (Winch& w : winches_) {
+    if (!w.fault.empty()) continue;
+    if (w.drive_node.configurator.state() == NodeConfigurator::State::kRunning && w.enable == EnableStep::kCheckMode) {
+      continue;  // a check already under way
+    }
+    w.enable = EnableStep::kCheckMode;
+    w.mode_check_started = false;
+  }
+  return hal::Status::Ok();
+}
+
+hal::Status CanopenWinchBank::reset_faults() {
+  if (hal::Status s = check_open(); !s.ok()) return s;
+  for (Winch& w : winches_) {
+    w.fault.clear();
+    w.emergency.clear();
+    w.encoder.reset();  // the next reading starts afresh
+    w.encoder_time_us = -1;
+    w.drive.request_fault_reset();
+    for (Node* node : {&w.drive_node, &w.encoder_node}) {
+      if (node->id == 0 || node->configured) continue;
+      node->configurator.cancel();
+      node->configure_at_us = now_us_;  // a refused configuration is tried again
+    }
+  }
+  return poll_drives(now_us_);
+}
+
+hal::Status CanopenWinchBank::disable() { return stop_all(Cia402Drive::Goal::kDisabled); }
+hal::Status CanopenWinchBank::quick_stop() { return stop_all(Cia402Drive::Goal::kQuickStop); }
+
+void CanopenWinchBank::cancel_coordinated_move() {
+  coordinated_move_pending_ = false;
+  for (Winch& w : winches_) {
+    if (w.profile_pending) w.drive_node.configurator.cancel();
+    w.profile_pending = false;
+  }
+}
 
 hal::Status CanopenWinchBank::halt() {
   if (hal::Status s = check_open(); !s.ok()) return s;
+  cancel_coordinated_move();
   for (Winch& w : winches_) w.drive.set_halt(true);
   return poll_drives(now_us_);
 }
 
-hal::Status CanopenWinchBank::set_target_payout(int winch, double payout_target_m) {
+hal::Result<std::int32_t> CanopenWinchBank::target_counts(int winch, double payout_target_m) {
   if (winch < 0 || winch >= winch_count() || !std::isfinite(payout_target_m)) {
     return hal::Status(hal::ErrorCode::kInvalidArgument,
                        "CAN winch bank: bad winch index " + std::to_string(winch) + " or non-finite target");
@@ -272,11 +492,16 @@ hal::Status CanopenWinchBank::set_target_payout(int winch, double payout_target_
   if (hal::Status s = check_open(); !s.ok()) return s;
   Winch& w = winches_[static_cast<std::size_t>(winch)];
   const hal::WinchStatus now = status(winch);
-  if (!now.alive || now.drive != hal::DriveState::kEnabled || !now.position_valid) {
+  if (!now.alive || now.drive != hal::DriveState::kEnabled || !now.position_valid || now.fault) {
     return hal::Status(hal::ErrorCode::kInvalidState,
                        "winch " + std::to_string(winch) + " (node " + std::to_string(w.drive_node.id) + "): " +
                            (now.alive ? std::string("drive ") + hal::to_string(now.drive) : std::string("node dead")) +
-                           ", target refused");
+                           (now.fault ? " with a fault" : "") + ", target refused");
+  }
+  if (std::abs(payout_target_m - now.payout_m) > config_.max_move_m) {
+    return hal::Status(hal::ErrorCode::kInvalidArgument,
+                       "winch " + std::to_string(winch) + ": a move of " + std::to_string(payout_target_m - now.payout_m) +
+                           " m exceeds max_move " + std::to_string(config_.max_move_m) + " m, target refused");
   }
   const double m_per_count = config_.winches[static_cast<std::size_t>(winch)].drive_m_per_count;
   const double target = static_cast<double>(w.drive.actual_counts()) +
@@ -284,12 +509,89 @@ hal::Status CanopenWinchBank::set_target_payout(int winch, double payout_target_
   if (target < std::numeric_limits<std::int32_t>::min() || target > std::numeric_limits<std::int32_t>::max()) {
     return hal::Status(hal::ErrorCode::kInvalidArgument, "winch " + std::to_string(winch) + ": target out of drive range");
   }
+  return static_cast<std::int32_t>(target);
+}
+
+hal::Status CanopenWinchBank::set_target_payout(int winch, double payout_target_m) {
+  hal::Result<std::int32_t> target = target_counts(winch, payout_target_m);
+  if (!target.ok()) return target.status();
+  Winch& w = winches_[static_cast<std::size_t>(winch)];
   w.target_payout_m = payout_target_m;
-  w.drive.command_target(static_cast<std::int32_t>(target));
+  w.drive.command_target(target.value());
   return poll_drives(now_us_);
 }
 
+hal::Status CanopenWinchBank::set_target_payouts(const double* payouts_m) {
+  // Everything checked before anything is sent: a refused winch moves none.
+  double longest_m = 0.0;
+  for (int i = 0; i < winch_count(); ++i) {
+    hal::Result<std::int32_t> target = target_counts(i, payouts_m[i]);
+    if (!target.ok()) return target.status();
+    Winch& w = winches_[static_cast<std::size_t>(i)];
+    w.pending_target_counts = target.value();
+    longest_m = std::max(longest_m, std::abs(payouts_m[i] - status(i).payout_m));
+  }
+  const DriveDescription& d = config_.drive;
+  for (int i = 0; i < winch_count(); ++i) {
+    Winch& w = winches_[static_cast<std::size_t>(i)];
+    const double share = longest_m > 0.0 ? std::abs(payouts_m[i] - status(i).payout_m) / longest_m : 1.0;
+    const double m_per_count = std::abs(config_.winches[static_cast<std::size_t>(i)].drive_m_per_count);
+    // At least one count per second (and per s^2): CiA 402 drives refuse 0.
+    const auto scaled = [&](double per_s) {
+      return static_cast<std::uint32_t>(std::max(1.0, std::round(share * per_s / m_per_count)));
+    };
+    w.profile_steps[0].value = scaled(d.profile_velocity_mps);
+    w.profile_steps[1].value = scaled(d.profile_acceleration_mps2);
+    w.profile_steps[2].value = scaled(d.profile_deceleration_mps2);
+    w.profile_pending = true;
+    w.drive_node.configurator.start(&w.profile_steps);
+    w.target_payout_m = payouts_m[i];
+  }
+  coordinated_move_pending_ = true;
+  return service_coordinated_move(now_us_);
+}
+
+hal::Status CanopenWinchBank::service_coordinated_move(hal::TimeUs now_us) {
+  if (!coordinated_move_pending_) return hal::Status::Ok();
+  hal::Status first_error;
+  bool all_written = true;
+  for (Winch& w : winches_) {
+    if (!w.profile_pending) continue;
+    NodeConfigurator& c = w.drive_node.configurator;
+    std::optional<CanFrame> frame = c.poll(now_us);
+    if (frame) {
+      if (hal::Status s = send(*frame); !s.ok() && first_error.ok()) first_error = s;
+    }
+    if (c.state() == NodeConfigurator::State::kDone) {
+      w.profile_pending = false;
+    } else if (c.state() == NodeConfigurator::State::kFailed || c.state() == NodeConfigurator::State::kNoAnswer) {
+      if (w.fault.empty()) w.fault = "move profile refused: " + c.error();
+      w.profile_pending = false;
+    } else {
+      all_written = false;
+    }
+  }
+  if (!all_written) return first_error;
+  coordinated_move_pending_ = false;
+  // Every profile is in place: the targets go out in this one cycle.
+  for (Winch& w : winches_) {
+    if (w.fault.empty()) w.drive.command_target(w.pending_target_counts);
+  }
+  if (hal::Status s = poll_drives(now_us); !s.ok() && first_error.ok()) first_error = s;
+  return first_error;
+}
+
+std::string CanopenWinchBank::fault_text(int winch) const {
+  if (winch < 0 || winch >= winch_count()) std::abort();  // caller's broken invariant (hal/winch_bank.h)
+  const Winch& w = winches_[static_cast<std::size_t>(winch)];
+  std::string text = w.fault;
+  if (!w.error_code.empty()) text += (text.empty() ? "" : "; ") + w.error_code;
+  if (!w.emergency.empty()) text += (text.empty() ? "" : "; last ") + w.emergency;
+  return text;
+}
+
 bool CanopenWinchBank::motion_finished() const {
+  if (coordinated_move_pending_) return false;
   for (int i = 0; i < winch_count(); ++i) {
     const hal::WinchStatus s = status(i);
     if (!s.alive || s.drive != hal::DriveState::kEnabled || !s.target_reached) return false;

@@ -1,24 +1,37 @@
 #pragma once
 // hal::WinchBank over CANopen: per winch one CiA 402 drive (profile position
-// mode) and optionally one CiA 406 cable encoder, with the PDO mapping of
-// drivers/can/canopen.h, on any CanTransport (SocketCAN or the virtual
-// robot's Unix socket: the protocol code is the same).
+// mode) and optionally one CiA 406 cable encoder, on any CanTransport
+// (SocketCAN or the virtual robot's Unix socket: the protocol code is the
+// same).
 //
-// Per node: a heartbeat consumer (alive when heard within
-// heartbeat_timeout_us; a boot-up or pre-operational heartbeat gets an NMT
-// start, rate-limited to one per resend interval) and, for drives, a
-// Cia402Drive state machine. A drive that reboots (boot-up heartbeat) is
-// started again but NOT re-enabled: it shows kDisabled until enable().
+// Per node, from open() or its boot-up: NMT enter pre-operational, then
+// configure-and-verify over SDO (device_configuration.h: identity, PDO
+// mapping, COB-IDs, transmission types, event timers, drive parameters,
+// heartbeats; the encoder's measuring range 0x6002 read), then NMT start.
+// A node that does not answer is tried again every resend interval; a
+// refusal or a read-back mismatch is a latched fault naming node, object
+// and values, and the drive is never enabled. Before every enable the
+// drive's mode is written (0x6060 = 1) and checked (0x6061).
+// The master produces its own heartbeat (0x700 + master_node_id) every
+// master_heartbeat_us; the drives' consumer heartbeat (0x1016) makes them
+// stop on their own when the master goes silent.
+// A node is alive when its heartbeat is fresh and says operational and its
+// TPDO is fresh (both within heartbeat_timeout_us). A drive that reboots
+// is configured and started again but NOT re-enabled: it shows kDisabled
+// until enable().
 //
-// Units: payout [m] = encoder counts x encoder_m_per_count (the encoder's
-// zero is the payout zero; the calibration estimates the offset). Targets go
-// to the drive relative to the present: target_counts = actual_counts +
-// round((target_m - payout_m) / drive_m_per_count), so motor and cable
-// encoder need not share a zero. Without an encoder node the drive's own
-// position is the payout (then the mapping is exact).
+// Units: payout [m] = encoder counts x encoder_m_per_count, the encoder's
+// UNSIGNED32 position unwrapped across its measuring range
+// (encoder_unwrap.h; a jump faster than max_speed_mps is a latched fault).
+// Targets go to the drive relative to the present: target_counts =
+// actual_counts + round((target_m - payout_m) / drive_m_per_count), so
+// motor and cable encoder need not share a zero; |target_m - payout_m| <=
+// max_move_m. Without an encoder node the drive's own position (INTEGER32)
+// is the payout.
 //
 // Errors, counters, allocation: see hal/winch_bank.h. update() reads at most
-// max_frames_per_update frames, so a babbling bus cannot starve the loop.
+// max_frames_per_update frames, so a babbling bus cannot starve the loop;
+// SDO transfers advance one frame per node per update(), never waiting.
 // The transport is made by the connector at open(), so open() after a lost
 // connection reconnects.
 
@@ -29,6 +42,9 @@
 
 #include "drivers/can/can_transport.h"
 #include "drivers/can/cia402_drive.h"
+#include "drivers/can/device_configuration.h"
+#include "drivers/can/encoder_unwrap.h"
+#include "drivers/can/node_configurator.h"
 #include "hal/winch_bank.h"
 
 namespace cdpr::drivers::can {
@@ -42,9 +58,16 @@ struct CanWinchConfig {
 
 struct CanWinchBankConfig {
   std::vector<CanWinchConfig> winches;
-  hal::TimeUs heartbeat_timeout_us = 500'000;  // consumer heartbeat time (>= 1.5 x producer period)
+  hal::TimeUs heartbeat_timeout_us = 500'000;  // node heartbeat and TPDO age limit (>= 1.5 x their periods)
   hal::TimeUs resend_interval_us = 100'000;    // NMT start / controlword resend when nothing moves on
   int max_frames_per_update = 256;
+  double max_move_m = 250.0;      // largest |target - payout| one command may ask for [m]
+  double max_speed_mps = 10.0;    // fastest a cable can pay out: bounds the change between two readings [m/s]
+  int master_node_id = 127;       // the heartbeat COB-ID 0x700 + this, and the drives' 0x1016 producer
+  hal::TimeUs master_heartbeat_us = 100'000;
+  hal::TimeUs sdo_timeout_us = 200'000;
+  DriveDescription drive;
+  EncoderDescription encoder;
 };
 
 using CanConnector = std::function<hal::Result<std::unique_ptr<CanTransport>>()>;
@@ -65,39 +88,74 @@ class CanopenWinchBank final : public hal::WinchBank {
   void close() override;
   hal::Status update(hal::TimeUs now_us) override;
   hal::WinchStatus status(int winch) const override;
+  std::string fault_text(int winch) const override;
   hal::WinchBankCounters counters() const override { return counters_; }
+  hal::Status reset_faults() override;
   hal::Status enable() override;
   hal::Status disable() override;
   hal::Status set_target_payout(int winch, double payout_m) override;
+  // Coordinated: per move, each drive's profile velocity, acceleration and
+  // deceleration (0x6081, 0x6083, 0x6084) are the description's scaled by
+  // |delta_i| / max |delta|, written over SDO, and then all targets are
+  // sent in the same cycle: every winch runs a time-scaled copy of the
+  // longest winch's trapezoid, so all start and arrive together and the
+  // payouts move along the straight line between the two waypoints.
+  hal::Status set_target_payouts(const double* payouts_m) override;
   hal::Status halt() override;
   hal::Status quick_stop() override;
   bool motion_finished() const override;
 
  private:
   struct Node {
+    Node(int node_id, hal::TimeUs sdo_timeout_us) : id(node_id), configurator(node_id, sdo_timeout_us) {}
     int id = 0;
     hal::TimeUs last_heartbeat_us = -1;
     NmtState nmt_state = NmtState::kBootUp;
-    bool start_wanted = false;
+    hal::TimeUs last_pdo_us = -1;
+    bool configured = false;
+    hal::TimeUs configure_at_us = -1;  // when to (re)start the configuration; -1: not planned
+    NodeConfigurator configurator;
+    std::vector<SdoStep> steps;
     hal::TimeUs last_start_sent_us = -1;
   };
+  enum class EnableStep { kNone, kCheckMode, kGoalSet };
   struct Winch {
     Node drive_node;
     Node encoder_node;  // id 0: none
     Cia402Drive drive;
-    std::int32_t encoder_counts = 0;
-    bool encoder_valid = false;
-    hal::TimeUs encoder_time_us = 0;
+    EncoderUnwrap encoder;
+    hal::TimeUs encoder_time_us = -1;
     double target_payout_m = 0.0;
+    EnableStep enable = EnableStep::kNone;
+    bool mode_check_started = false;
+    std::vector<SdoStep> profile_steps;  // this move's 0x6081/0x6083/0x6084
+    bool profile_pending = false;       // written before the coordinated target goes out
+    std::int32_t pending_target_counts = 0;
+    std::string fault;  // latched: configuration refused or mismatched, encoder jump
+    std::string emergency;  // the latest EMCY of its nodes, for messages
+    std::vector<SdoStep> error_code_steps;  // 0x603F, read once per drive fault
+    bool error_code_asked = false;
+    std::string error_code;  // "0x603F = 0x8611 (following error)" of the present fault
   };
 
   hal::Status send(const CanFrame& frame);
   void dispatch(const CanFrame& frame, hal::TimeUs now_us);
+  void on_position(Winch& winch, std::uint32_t raw, hal::TimeUs now_us);
   void on_heartbeat(Winch& winch, Node& node, NmtState state, hal::TimeUs now_us);
-  hal::Status service_node(Node& node, hal::TimeUs now_us);
+  void on_emergency(Winch& winch, const Node& node, const CanFrame& frame);
+  hal::Status service_node(Winch& winch, Node& node, hal::TimeUs now_us);
+  hal::Status service_enable(Winch& winch, hal::TimeUs now_us);
+  hal::Status service_coordinated_move(hal::TimeUs now_us);
+  // Reads 0x603F of a drive that entered fault (what EMCY may have missed).
+  hal::Status service_error_code(Winch& winch, hal::TimeUs now_us);
+  // The drive target for `payout_target_m`, or why not.
+  hal::Result<std::int32_t> target_counts(int winch, double payout_target_m);
+  hal::Status send_master_heartbeat(hal::TimeUs now_us);
   // Sends what the drive state machines want now; first error wins.
   hal::Status poll_drives(hal::TimeUs now_us);
-  hal::Status set_goal_all(Cia402Drive::Goal goal);
+  // Disable or quick stop: cancels enabling and a move not yet sent.
+  hal::Status stop_all(Cia402Drive::Goal goal);
+  void cancel_coordinated_move();
   bool node_alive(const Node& node) const;
   double payout_m(const Winch& winch) const;
   hal::Status check_open() const;
@@ -106,7 +164,10 @@ class CanopenWinchBank final : public hal::WinchBank {
   CanConnector connector_;
   std::unique_ptr<CanTransport> transport_;
   std::vector<Winch> winches_;
+  std::vector<SdoStep> mode_steps_;
+  bool coordinated_move_pending_ = false;
   hal::TimeUs now_us_ = 0;
+  hal::TimeUs last_master_heartbeat_us_ = -1;
   hal::WinchBankCounters counters_;
 };
 

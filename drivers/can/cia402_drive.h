@@ -27,15 +27,25 @@ class Cia402Drive {
 
   // Forgets everything heard (node rebooted or lost); keeps the goal.
   void reset();
+  // kEnabled allows one fault reset (the operator's explicit request); a
+  // fault after the drive was enabled stays latched until the next call.
   void set_goal(Goal goal);
   Goal goal() const { return goal_; }
+  // The operator's request: a drive in fault gets one fault reset (and
+  // stays disabled) whatever the goal.
+  void request_fault_reset();
   // Halt bit (decelerate and hold) while enabled; a new target clears it.
   void set_halt(bool halt) { halt_ = halt; }
 
   // A TxPDO from the drive.
   void on_status(const DriveTxPdo& pdo);
   // Starts the new-setpoint handshake for `target_counts`. Precondition:
-  // drive_state() == kEnabled (checked by the caller).
+  // drive_state() == kEnabled (checked by the caller). The CiA 402
+  // handshake is finished before a new one starts: bit 4 up, acknowledge
+  // seen 1, bit 4 down, acknowledge seen 0. A target given meanwhile waits
+  // (the latest one wins), so a late acknowledgement of the previous
+  // set-point is never taken for the new one and no edge falls on a drive
+  // that still refuses set-points.
   void command_target(std::int32_t target_counts);
 
   // The RxPDO to send now, if any: when the wanted controlword or target
@@ -53,7 +63,10 @@ class Cia402Drive {
   std::uint64_t resends() const { return resends_; }
 
  private:
+  // kPending: bit 4 high, waiting for the acknowledge; kAcknowledged: bit 4
+  // low, waiting for the acknowledge to clear.
   enum class Setpoint { kIdle, kPending, kAcknowledged };
+  void start_queued();
 
   // The controlword that moves the drive towards the goal from its state.
   std::uint16_t wanted_controlword(bool resend_due) const;
@@ -69,11 +82,15 @@ class Cia402Drive {
   std::int32_t actual_counts_ = 0;
   std::int32_t target_counts_ = 0;
   Setpoint setpoint_ = Setpoint::kIdle;
+  bool queued_ = false;
+  std::int32_t queued_target_counts_ = 0;
+  bool ack_seen_ = false;  // the acknowledge bit of the latest statusword
   bool sent_any_ = false;
   std::uint16_t last_controlword_ = 0;
   std::int32_t last_target_counts_ = 0;
   hal::TimeUs last_sent_us_ = 0;
   std::uint64_t resends_ = 0;
+  bool fault_reset_allowed_ = false;
 };
 
 }  // namespace cdpr::drivers::can

@@ -39,6 +39,9 @@ struct CalibrationStatus {
   std::string reason;          // why the last run failed, or what it committed
   std::string note;            // latest remark (skipped waypoint, ignored button press, ...)
   std::string detail;          // what the current state waits for (e.g. "platform moving: 4.1 mm/s")
+  // Latched device faults and their causes ("winch 0: node 11: position
+  // jumped ..."; EMCY codes), until `reset-faults` or a run's enable.
+  std::string device_faults;
   int committed_seq = 0;       // store sequence number committed by the last run; 0 if none
   hal::TimeUs started_us = -1;        // monotonic start of the last run; -1 never
   hal::TimeUs state_entered_us = -1;  // when the current state was entered

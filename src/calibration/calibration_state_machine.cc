@@ -69,6 +69,44 @@ bool CalibrationStateMachine::request_start(hal::TimeUs now_us) {
   return true;
 }
 
+bool CalibrationStateMachine::request_reset_faults(hal::TimeUs now_us) {
+  (void)now_us;
+  if (is_running(status_.state)) {
+    status_.note = "reset-faults refused: a calibration is running (abort it first)";
+    return false;
+  }
+  if (const hal::Status s = devices_.winches.reset_faults(); !s.ok()) {
+    status_.note = "reset-faults failed: " + s.to_string();
+    return false;
+  }
+  status_.note = "faults reset" + (status_.device_faults.empty() ? std::string(" (there were none)")
+                                                                  : " (were: " + status_.device_faults + ")");
+  status_.device_faults.clear();
+  return true;
+}
+
+void CalibrationStateMachine::refresh_device_faults() {
+  // Cheap flags first: the texts are built only while a fault is there.
+  bool any = false;
+  for (int i = 0; i < devices_.winches.winch_count(); ++i) {
+    const hal::WinchStatus s = devices_.winches.status(i);
+    any = any || s.fault || s.drive == hal::DriveState::kFault;
+  }
+  if (!any) {
+    if (!status_.device_faults.empty()) status_.device_faults.clear();
+    return;
+  }
+  std::string faults;
+  for (int i = 0; i < devices_.winches.winch_count(); ++i) {
+    const hal::WinchStatus s = devices_.winches.status(i);
+    if (!s.fault && s.drive != hal::DriveState::kFault) continue;
+    const std::string text = devices_.winches.fault_text(i);
+    faults += (faults.empty() ? "" : "; ") + std::string("winch ") + std::to_string(i) + ": " +
+              (text.empty() ? std::string("drive fault") : text);
+  }
+  if (faults != status_.device_faults) status_.device_faults = std::move(faults);
+}
+
 bool CalibrationStateMachine::request_abort(hal::TimeUs now_us, const std::string& why) {
   if (!is_running(status_.state)) {
     status_.note = "abort ignored: no calibration running";
@@ -115,6 +153,7 @@ void CalibrationStateMachine::poll_button(hal::TimeUs now_us) {
 
 void CalibrationStateMachine::step(hal::TimeUs now_us) {
   poll_button(now_us);
+  refresh_device_faults();
   const CalibrationState state = status_.state;
   if (in_motion_phase(state)) {
     if (std::string fault = monitor_.poll(now_us); !fault.empty()) return fail(fault, now_us, true);
@@ -210,10 +249,9 @@ void CalibrationStateMachine::run_plan(hal::TimeUs now_us) {
 void CalibrationStateMachine::run_move(hal::TimeUs now_us) {
   const Waypoint& waypoint = plan_.waypoints[waypoint_index_];
   if (!targets_sent_) {
-    for (int i = 0; i < kCableCount; ++i) {
-      if (const hal::Status s = devices_.winches.set_target_payout(i, waypoint.payout_m[i]); !s.ok()) {
-        return fail("winch " + std::to_string(i) + " target: " + s.to_string(), now_us, true);
-      }
+    // All four together: they start and arrive at the same time.
+    if (const hal::Status s = devices_.winches.set_target_payouts(waypoint.payout_m.data()); !s.ok()) {
+      return fail("winch targets: " + s.to_string(), now_us, true);
     }
     targets_sent_ = true;
     status_.detail = "moving to waypoint " + std::to_string(status_.waypoint);

@@ -107,6 +107,9 @@ class CalibrationStateMachine {
   bool request_start(hal::TimeUs now_us);
   // Aborts a run in progress (winches halted, old calibration kept). Returns
   // false (and notes it) when nothing is running.
+  // The operator's request to clear the devices' latched faults (calibctl
+  // reset-faults). Refused (false, note says why) while a run is going.
+  bool request_reset_faults(hal::TimeUs now_us);
   bool request_abort(hal::TimeUs now_us, const std::string& why = "abort requested");
 
   // Asynchronous solve (no SolveFunction given).
@@ -133,6 +136,8 @@ class CalibrationStateMachine {
   void enter(CalibrationState state, hal::TimeUs now_us);
   void fail(const std::string& reason, hal::TimeUs now_us, bool fault);
   void poll_button(hal::TimeUs now_us);
+  // status().device_faults from the winch bank's latched faults.
+  void refresh_device_faults();
   void run_preflight(hal::TimeUs now_us);
   void run_plan(hal::TimeUs now_us);
   void run_move(hal::TimeUs now_us);

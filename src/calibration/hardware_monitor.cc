@@ -69,7 +69,11 @@ std::string HardwareMonitor::check(hal::TimeUs now_us, bool drives_enabled) cons
                                                                          " ago") +
              ")";
     }
-    if (w.drive == hal::DriveState::kFault) return winch + " drive fault";
+    if (w.fault) return winch + ": " + winches_.fault_text(i);
+    if (w.drive == hal::DriveState::kFault) {
+      const std::string cause = winches_.fault_text(i);
+      return winch + " drive fault" + (cause.empty() ? std::string() : ": " + cause);
+    }
     if (drives_enabled && w.drive != hal::DriveState::kEnabled) {
       return winch + " drive left operation enabled (now " + hal::to_string(w.drive) + ")";
     }

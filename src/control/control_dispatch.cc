@@ -20,6 +20,9 @@ std::string respond(std::string_view request_line, calibration::CalibrationState
       }
       return format_ok_response("aborted: " + machine.status().reason);
     case RequestKind::kStatus: return format_status_response(machine.status(), now_us);
+    case RequestKind::kResetFaults:
+      if (!machine.request_reset_faults(now_us)) return format_error_response(machine.status().note);
+      return format_ok_response(machine.status().note);
     case RequestKind::kShow: {
       const auto current = store.load_current();
       if (!current) {

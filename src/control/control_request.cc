@@ -12,7 +12,7 @@ struct Command {
   bool takes_seq;
 };
 
-constexpr std::array<Command, 7> kCommands = {{
+constexpr std::array<Command, 8> kCommands = {{
     {"start", RequestKind::kStart, false},
     {"abort", RequestKind::kAbort, false},
     {"status", RequestKind::kStatus, false},
@@ -20,9 +20,11 @@ constexpr std::array<Command, 7> kCommands = {{
     {"history", RequestKind::kHistory, false},
     {"rollback", RequestKind::kRollback, true},
     {"commit", RequestKind::kCommit, false},
+    {"reset-faults", RequestKind::kResetFaults, false},
 }};
 
-constexpr const char* kExpected = "expected start, abort, status, show, history, rollback <seq> or commit";
+constexpr const char* kExpected =
+    "expected start, abort, status, show, history, rollback <seq>, commit or reset-faults";
 
 bool is_blank(char c) { return c == ' ' || c == '\t'; }
 

@@ -13,6 +13,7 @@
 //   history          the stored versions
 //   rollback <seq>   make stored version <seq> current again (seq: 1..999999999)
 //   commit           commit the fit a failed commit kept in <state>/pending
+//   reset-faults     clear the devices' latched faults (not during a run)
 //
 // Every request gets exactly one response line (control_response.h). The
 // parser accepts any byte sequence without crashing and refuses everything
@@ -27,7 +28,9 @@ namespace cdpr::control {
 
 inline constexpr std::size_t kMaxRequestBytes = 256;
 
-enum class RequestKind { kStart, kAbort, kStatus, kShow, kHistory, kRollback, kCommit };
+enum class RequestKind {
+  kStart, kAbort, kStatus, kShow, kHistory, kRollback, kCommit, kResetFaults
+};
 
 const char* to_string(RequestKind kind);
 

@@ -45,6 +45,7 @@ std::string format_status_response(const calibration::CalibrationStatus& status,
     json.value(1e-6 * static_cast<double>(end_us - status.started_us));
   }
   json.key("reason").value(status.reason).key("note").value(status.note).key("detail").value(status.detail);
+  json.key("device_faults").value(status.device_faults);
   json.key("committed_seq").value(status.committed_seq);
   json.key("interrupted").value(status.interrupted);
   json.key("store_problems").begin_array();

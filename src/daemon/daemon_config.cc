@@ -35,6 +35,14 @@ class ConfigReader {
     }
     out = static_cast<int>(value);
   }
+  // An UNSIGNED32 (CANopen identity values).
+  void unsigned32(const toml::table& t, std::string_view key, std::string_view path, std::int64_t& out) {
+    if (!t.contains(key) || reader_.failed()) return;
+    const std::int64_t value = reader_.integer(t, key, path);
+    if (reader_.failed()) return;
+    if (value < 0 || value > 0xFFFFFFFFll) return fail(t, key, path, "must be in 0..0xFFFFFFFF");
+    out = value;
+  }
   void number(const toml::table& t, std::string_view key, std::string_view path, double& out, Bound bound) {
     note_line(t, key, path);
     if (const auto value = reader_.optional_number(t, key, path, bound)) out = *value;
@@ -107,13 +115,61 @@ bool is_group_name_or_id(const std::string& group) {
   return last > 0;
 }
 
+void read_can_devices(TomlReader& reader, ConfigReader& r, const toml::table& winches, WinchesConfig& out) {
+  const toml::table& d = reader.table(winches, "drive", "winches", kOptional);
+  const char* dp = "winches.drive";
+  reader.check_keys(d, dp, {{"vendor_id", kOptional}, {"product_code", kOptional}, {"quick_stop_option", kOptional},
+                            {"abort_connection_option", kOptional}, {"following_error_window_m", kOptional},
+                            {"profile_velocity_mps", kOptional}, {"profile_acceleration_mps2", kOptional},
+                            {"profile_deceleration_mps2", kOptional}, {"quick_stop_deceleration_mps2", kOptional},
+                            {"heartbeat_producer_ms", kOptional}, {"consumer_heartbeat_ms", kOptional},
+                            {"pdo_event_timer_ms", kOptional}});
+  CanDriveDescription& drive = out.drive;
+  r.unsigned32(d, "vendor_id", dp, drive.vendor_id);
+  r.unsigned32(d, "product_code", dp, drive.product_code);
+  r.integer(d, "quick_stop_option", dp, drive.quick_stop_option, 0, 6);
+  if (drive.quick_stop_option == 3 || drive.quick_stop_option == 4) {
+    r.fail(d, "quick_stop_option", dp, "must be 0, 1, 2, 5 or 6 (3 and 4 stop at a current or voltage limit)");
+  }
+  r.integer(d, "abort_connection_option", dp, drive.abort_connection_option, 0, 3);
+  r.number(d, "following_error_window_m", dp, drive.following_error_window_m, Bound::kPositive);
+  r.number(d, "profile_velocity_mps", dp, drive.profile_velocity_mps, Bound::kPositive);
+  r.number(d, "profile_acceleration_mps2", dp, drive.profile_acceleration_mps2, Bound::kPositive);
+  r.number(d, "profile_deceleration_mps2", dp, drive.profile_deceleration_mps2, Bound::kPositive);
+  r.number(d, "quick_stop_deceleration_mps2", dp, drive.quick_stop_deceleration_mps2, Bound::kPositive);
+  r.duration_us(d, "heartbeat_producer_ms", dp, drive.heartbeat_producer_us, 1e3);
+  r.duration_us(d, "consumer_heartbeat_ms", dp, drive.consumer_heartbeat_us, 1e3);
+  r.duration_us(d, "pdo_event_timer_ms", dp, drive.pdo_event_timer_us, 1e3);
+  if (drive.consumer_heartbeat_us <= out.master_heartbeat_us) {
+    r.fail(d, "consumer_heartbeat_ms", dp, "must exceed winches.master_heartbeat_ms");
+  }
+
+  const toml::table& e = reader.table(winches, "encoder", "winches", kOptional);
+  const char* ep = "winches.encoder";
+  reader.check_keys(e, ep, {{"vendor_id", kOptional}, {"product_code", kOptional}, {"heartbeat_producer_ms", kOptional},
+                            {"pdo_event_timer_ms", kOptional}});
+  r.unsigned32(e, "vendor_id", ep, out.encoder.vendor_id);
+  r.unsigned32(e, "product_code", ep, out.encoder.product_code);
+  r.duration_us(e, "heartbeat_producer_ms", ep, out.encoder.heartbeat_producer_us, 1e3);
+  r.duration_us(e, "pdo_event_timer_ms", ep, out.encoder.pdo_event_timer_us, 1e3);
+}
+
 void read_winches(TomlReader& reader, ConfigReader& r, const toml::table& root, WinchesConfig& out) {
   const toml::table& t = reader.table(root, "winches", "", kOptional);
   reader.check_keys(t, "winches", {{"endpoint", kOptional}, {"heartbeat_timeout_ms", kOptional},
-                                   {"resend_interval_ms", kOptional}, {"winch", kOptional}});
+                                   {"resend_interval_ms", kOptional}, {"winch", kOptional},
+                                   {"max_move_m", kOptional}, {"max_speed_mps", kOptional},
+                                   {"master_node_id", kOptional}, {"master_heartbeat_ms", kOptional},
+                                   {"sdo_timeout_ms", kOptional}, {"drive", kOptional}, {"encoder", kOptional}});
   r.string(t, "endpoint", "winches", out.endpoint);
   r.duration_us(t, "heartbeat_timeout_ms", "winches", out.heartbeat_timeout_us, 1e3);
   r.duration_us(t, "resend_interval_ms", "winches", out.resend_interval_us, 1e3);
+  r.number(t, "max_move_m", "winches", out.max_move_m, Bound::kPositive);
+  r.number(t, "max_speed_mps", "winches", out.max_speed_mps, Bound::kPositive);
+  r.integer(t, "master_node_id", "winches", out.master_node_id, 1, 127);
+  r.duration_us(t, "master_heartbeat_ms", "winches", out.master_heartbeat_us, 1e3);
+  r.duration_us(t, "sdo_timeout_ms", "winches", out.sdo_timeout_us, 1e3);
+  read_can_devices(reader, r, t, out);
   if (!t.contains("winch")) return;
   const auto tables = reader.tables(t, "winch", "winches");
   if (!reader.failed() && tables.size() != static_cast<std::size_t>(kCableCount)) {

@@ -11,6 +11,7 @@
 // Driver settings are plain values here (src/ does not see drivers/);
 // main() turns them into the drivers' own configurations.
 
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -35,10 +36,41 @@ struct WinchNodes {
   double drive_m_per_count = 1e-5;    // payout per drive count [m], != 0
 };
 
+// What the master writes into every CiA 402 drive before starting it
+// (drivers/can/device_configuration.h), in metres, seconds and CiA codes.
+struct CanDriveDescription {
+  std::int64_t vendor_id = 0;     // 0x1018:01 expected; 0: not checked
+  std::int64_t product_code = 0;  // 0x1018:02 expected; 0: not checked
+  int quick_stop_option = 6;        // 0x605A
+  int abort_connection_option = 3;  // 0x6007: reaction to the master's heartbeat lost
+  double following_error_window_m = 0.1;      // 0x6065
+  double profile_velocity_mps = 2.0;          // 0x6081
+  double profile_acceleration_mps2 = 1.0;     // 0x6083
+  double profile_deceleration_mps2 = 1.0;     // 0x6084
+  double quick_stop_deceleration_mps2 = 2.0;  // 0x6085
+  hal::TimeUs heartbeat_producer_us = 100'000;  // 0x1017
+  hal::TimeUs consumer_heartbeat_us = 500'000;  // 0x1016:01, monitoring the master
+  hal::TimeUs pdo_event_timer_us = 20'000;      // TPDO1 0x1800:05
+};
+
+struct CanEncoderDescription {
+  std::int64_t vendor_id = 0;
+  std::int64_t product_code = 0;
+  hal::TimeUs heartbeat_producer_us = 100'000;
+  hal::TimeUs pdo_event_timer_us = 20'000;
+};
+
 struct WinchesConfig {
   std::string endpoint = "socketcan:can0";  // or "unix:<path>"
   hal::TimeUs heartbeat_timeout_us = 500'000;
   hal::TimeUs resend_interval_us = 100'000;
+  double max_move_m = 250.0;    // largest |target - payout| of one command [m]
+  double max_speed_mps = 10.0;  // fastest payout change; a larger jump between readings is a fault [m/s]
+  int master_node_id = 127;     // heartbeat producer 0x700 + this
+  hal::TimeUs master_heartbeat_us = 100'000;
+  hal::TimeUs sdo_timeout_us = 200'000;
+  CanDriveDescription drive;      // [winches.drive]
+  CanEncoderDescription encoder;  // [winches.encoder]
   std::vector<WinchNodes> winches;  // in cable order; default: drives 1..4, encoders 11..14
 };
 

@@ -1,11 +1,14 @@
-// Loopback: the CANopen winch bank against fake CiA 402/406 nodes on the far
-// end of a real Unix stream socket pair, time stepped by the test.
+// Loopback: the CANopen winch bank against the virtual robot's simulated
+// CiA 402 drives and CiA 406 encoders (their own object dictionaries from
+// the profiles' defaults, written without the master's code) on the far end
+// of a real Unix stream socket pair, time stepped by the test.
 
 #include "drivers/can/canopen_winch_bank.h"
 
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <memory>
 
 #include <gtest/gtest.h>
@@ -19,39 +22,72 @@ namespace {
 constexpr double kEncoderMPerCount = 1e-4;  // 0.1 mm per encoder count
 constexpr double kDriveMPerCount = 2e-4;    // fake gearing: 2 encoder counts per drive count
 
+CanWinchBankConfig two_winches() {
+  CanWinchBankConfig config;
+  config.winches = {{1, 11, kEncoderMPerCount, kDriveMPerCount}, {2, 12, kEncoderMPerCount, kDriveMPerCount}};
+  config.heartbeat_timeout_us = 500'000;
+  config.drive.profile_velocity_mps = 4.0;  // 20000 drive counts/s
+  config.drive.profile_acceleration_mps2 = 40.0;
+  config.drive.profile_deceleration_mps2 = 40.0;
+  config.drive.quick_stop_deceleration_mps2 = 40.0;
+  config.drive.pdo_event_timer_us = 10'000;
+  config.encoder.pdo_event_timer_us = 10'000;
+  return config;
+}
+
 class CanopenWinchBankTest : public ::testing::Test {
  protected:
-  void SetUp() override {
+  // The bus with two winches whose drives start from `drive` defaults.
+  void start(const CanWinchBankConfig& config = two_winches(), const virtual_robot::DriveDefaults& drive = {}) {
     int fds[2];
     ASSERT_EQ(::socketpair(AF_UNIX, SOCK_STREAM, 0, fds), 0);
-    bus_ = std::make_unique<test::FakeCanopenBus>(fds[1]);
+    bus_ = std::make_unique<test::FakeCanopenBus>(fds[1], drive);
     bus_->add(1, 11);
     bus_->add(2, 12);
-    CanWinchBankConfig config;
-    config.winches = {{1, 11, kEncoderMPerCount, kDriveMPerCount}, {2, 12, kEncoderMPerCount, kDriveMPerCount}};
-    config.heartbeat_timeout_us = 500'000;
     const int bank_fd = fds[0];
     bank_ = std::make_unique<CanopenWinchBank>(config, [bank_fd]() -> hal::Result<std::unique_ptr<CanTransport>> {
       return std::unique_ptr<CanTransport>(std::make_unique<FdCanTransport>(bank_fd, "test bank"));
     });
   }
 
-  // Steps the fake nodes and the bank every 5 ms for `duration_ms`.
-  void run_ms(int duration_ms) {
+  // Steps the fake nodes and the bank every 5 ms for `duration_ms`; the
+  // bank only while `master_alive`.
+  void run_ms(int duration_ms, bool master_alive = true) {
     for (int t = 0; t < duration_ms; t += 5) {
       now_us_ += 5'000;
       bus_->step(now_us_);
-      ASSERT_TRUE(bank_->update(now_us_).ok());
+      if (master_alive) {
+        ASSERT_TRUE(bank_->update(now_us_).ok());
+      }
     }
   }
 
-  // Opens the bank and brings both drives to operation enabled.
-  void open_and_enable() {
+  // Opens the bank and runs until both winches are alive (configured).
+  void open_and_configure() {
     ASSERT_TRUE(bank_->open().ok());
-    run_ms(50);
+    for (int i = 0; i < 200 && !(bank_->status(0).alive && bank_->status(1).alive); ++i) run_ms(5);
+    ASSERT_TRUE(bank_->status(0).alive) << bank_->fault_text(0);
+    ASSERT_TRUE(bank_->status(1).alive) << bank_->fault_text(1);
+  }
+
+  // ... and brings both drives to operation enabled.
+  void open_and_enable() {
+    open_and_configure();
     ASSERT_TRUE(bank_->enable().ok());
     run_ms(100);
     for (int i = 0; i < 2; ++i) ASSERT_EQ(bank_->status(i).drive, hal::DriveState::kEnabled) << "winch " << i;
+  }
+
+  // Sends winch 0 4 m (1 s), quick-stops after 100 ms, waits 400 ms;
+  // returns its payout 200 ms after the quick stop.
+  double quick_stop_during_a_long_move() {
+    EXPECT_TRUE(bank_->set_target_payout(0, bank_->status(0).payout_m + 4.0).ok());
+    run_ms(100);
+    EXPECT_TRUE(bank_->quick_stop().ok());
+    run_ms(200);
+    const double stopped_m = bank_->status(0).payout_m;
+    run_ms(200);
+    return stopped_m;
   }
 
   hal::TimeUs now_us_ = 0;
@@ -59,59 +95,285 @@ class CanopenWinchBankTest : public ::testing::Test {
   std::unique_ptr<CanopenWinchBank> bank_;
 };
 
-TEST_F(CanopenWinchBankTest, StartsNodesAndEnablesDrives) {
-  // GIVEN booting nodes WHEN the bank opens and runs a while
-  ASSERT_TRUE(bank_->open().ok());
-  run_ms(50);
-  // THEN the nodes were started (NMT), are alive, positions arrive, drives still disabled
-  for (std::size_t i = 0; i < 2; ++i) EXPECT_EQ(bus_->drive(i).nmt, NmtState::kOperational);
+TEST_F(CanopenWinchBankTest, ConfiguresStartsAndEnablesDrives) {
+  // GIVEN nodes at their profiles' defaults WHEN the bank opens and runs
+  start();
+  open_and_configure();
+  // THEN each node is configured as described and started
+  virtual_robot::Cia402Device& d = bus_->drive(0);
+  EXPECT_EQ(d.state(), virtual_robot::NodeState::kOperational);
+  EXPECT_EQ(d.od().get(0x1600, 0), 2u);
+  EXPECT_EQ(d.od().get(0x1600, 2), 0x607A0020u);
+  EXPECT_EQ(d.od().get(0x1A00, 2), 0x60640020u);
+  EXPECT_EQ(d.od().get(0x1800, 5), 10u);
+  EXPECT_EQ(d.od().get(0x1017, 0), 100u);
+  EXPECT_EQ(d.od().get(0x1016, 1), (127u << 16) | 500u);
+  EXPECT_EQ(d.od().get(0x6007, 0), 3u);
+  EXPECT_EQ(d.od().get(0x6081, 0), 20000u);
+  EXPECT_EQ(bus_->encoder(0).od().get(0x1A00, 1), 0x60040020u);
+  EXPECT_EQ(bus_->encoder(0).state(), virtual_robot::NodeState::kOperational);
+  // AND alive with positions, drives still disabled
   hal::WinchStatus s = bank_->status(0);
-  EXPECT_TRUE(s.alive);
   EXPECT_GE(s.heartbeat_age_us, 0);
   EXPECT_TRUE(s.position_valid);
-  EXPECT_NEAR(s.payout_m, bus_->encoder_counts(bus_->drive(0)) * kEncoderMPerCount, 1e-12);
+  EXPECT_NEAR(s.payout_m, static_cast<double>(bus_->encoder_counts(0)) * kEncoderMPerCount, 1e-12);
   EXPECT_EQ(s.drive, hal::DriveState::kDisabled);
-  // WHEN enabled THEN every drive walks to operation enabled and holds still
+  // WHEN enabled THEN profile position mode is set and every drive is enabled
   ASSERT_TRUE(bank_->enable().ok());
   run_ms(100);
   for (std::size_t i = 0; i < 2; ++i) {
-    EXPECT_EQ(bus_->drive(i).power, cia402::PowerState::kOperationEnabled);
+    EXPECT_EQ(bus_->drive(i).od().get(0x6061, 0), 1u);
+    EXPECT_TRUE(bus_->drive(i).operation_enabled());
     EXPECT_EQ(bank_->status(static_cast<int>(i)).drive, hal::DriveState::kEnabled);
   }
   EXPECT_TRUE(bank_->motion_finished());
-  EXPECT_GT(bank_->counters().frames_rx, 0u);
-  EXPECT_GT(bank_->counters().frames_tx, 0u);
   EXPECT_EQ(bank_->counters().errors, 0u);
 }
 
-TEST_F(CanopenWinchBankTest, MovesToTargetPayoutAndReportsFinished) {
-  // GIVEN enabled drives
+TEST_F(CanopenWinchBankTest, DriveWithPredefinedMappingMovesOnlyAfterConfiguration) {
+  // GIVEN drives with CiA 402's predefined PDOs (RPDO1 = controlword only,
+  // TPDO1 = statusword only) WHEN configured, enabled and sent 0.2 m
+  start();
   open_and_enable();
   const double start_m = bank_->status(0).payout_m;
-  // WHEN winch 0 is sent 0.2 m further (1000 drive counts at 20000 counts/s: 50 ms)
   ASSERT_TRUE(bank_->set_target_payout(0, start_m + 0.2).ok());
-  // THEN it is not finished at once (handshake pending) ...
+  // THEN not finished at once (handshake pending) ...
   EXPECT_FALSE(bank_->motion_finished());
   run_ms(20);
   EXPECT_FALSE(bank_->motion_finished());
-  // ... and after the move it is, with the encoder at the target
-  run_ms(200);
+  // ... and after the move it is, with the encoder at the target: the target
+  // position travelled with the controlword in one RPDO
+  run_ms(300);
   EXPECT_TRUE(bank_->motion_finished());
   EXPECT_NEAR(bank_->status(0).payout_m, start_m + 0.2, kEncoderMPerCount);
-  EXPECT_NEAR(bank_->status(0).target_payout_m, start_m + 0.2, 1e-12);
-  EXPECT_EQ(bus_->drive(0).target_counts, 1000);
+  EXPECT_NEAR(bus_->drive(0).position_counts(), 1000.0, 0.5);
   // WHEN a second target follows THEN the drive takes it too (new rising edge)
   ASSERT_TRUE(bank_->set_target_payout(0, start_m + 0.1).ok());
-  run_ms(200);
+  run_ms(300);
   EXPECT_TRUE(bank_->motion_finished());
   EXPECT_NEAR(bank_->status(0).payout_m, start_m + 0.1, kEncoderMPerCount);
 }
 
+TEST_F(CanopenWinchBankTest, CoordinatedMoveStartsAndArrivesTogether) {
+  // GIVEN enabled drives
+  start();
+  open_and_enable();
+  const double start0_m = bank_->status(0).payout_m, start1_m = bank_->status(1).payout_m;
+  // WHEN winch 0 is sent 0.8 m and winch 1 0.2 m in one coordinated move
+  const double targets_m[2] = {start0_m + 0.8, start1_m - 0.2};
+  ASSERT_TRUE(bank_->set_target_payouts(targets_m).ok());
+  // THEN winch 1 runs at a quarter of winch 0's profile (0x6081/0x6083/0x6084 scaled by |delta|) ...
+  run_ms(40);
+  EXPECT_EQ(bus_->drive(0).od().get(0x6081, 0), 20000u);
+  EXPECT_EQ(bus_->drive(1).od().get(0x6081, 0), 5000u);
+  EXPECT_EQ(bus_->drive(1).od().get(0x6083, 0), 50000u);
+  // ... so both are the same fraction of the way at every moment, and arrive together
+  for (int step = 0; step < 80; ++step) {
+    run_ms(5);
+    const double done0 = (bank_->status(0).payout_m - start0_m) / 0.8;
+    const double done1 = (start1_m - bank_->status(1).payout_m) / 0.2;
+    ASSERT_NEAR(done0, done1, 0.03) << "at step " << step;
+  }
+  run_ms(100);
+  EXPECT_TRUE(bank_->motion_finished());
+  EXPECT_NEAR(bank_->status(0).payout_m, targets_m[0], kEncoderMPerCount);
+  EXPECT_NEAR(bank_->status(1).payout_m, targets_m[1], kEncoderMPerCount);
+}
+
+TEST_F(CanopenWinchBankTest, DriveLeftInHomingModeIsSwitchedToProfilePosition) {
+  // GIVEN drives that power on in homing mode (0x6060 = 6)
+  virtual_robot::DriveDefaults homing;
+  homing.power_on_mode = 6;
+  start(two_winches(), homing);
+  // WHEN enabled and sent 0.2 m
+  open_and_enable();
+  EXPECT_EQ(bus_->drive(0).od().get(0x6061, 0), 1u);
+  const double start_m = bank_->status(0).payout_m;
+  ASSERT_TRUE(bank_->set_target_payout(0, start_m + 0.2).ok());
+  run_ms(300);
+  // THEN it moved there (in homing, bit 4 would have re-zeroed the drive instead)
+  EXPECT_TRUE(bank_->motion_finished());
+  EXPECT_NEAR(bank_->status(0).payout_m, start_m + 0.2, kEncoderMPerCount);
+}
+
+TEST_F(CanopenWinchBankTest, IdentityMismatchRefusesToEnable) {
+  // GIVEN a configuration that expects another vendor than the drives have
+  CanWinchBankConfig config = two_winches();
+  config.drive.vendor_id = 0x1234;
+  start(config);
+  ASSERT_TRUE(bank_->open().ok());
+  run_ms(200);
+  // THEN winch 0 has a fault naming node, object and both values, and is never enabled
+  const hal::WinchStatus s = bank_->status(0);
+  EXPECT_TRUE(s.fault);
+  EXPECT_NE(bank_->fault_text(0).find("node 1: 0x1018:0x01 (vendor id) is 0x0000CD42, expected 0x00001234"),
+            std::string::npos)
+      << bank_->fault_text(0);
+  ASSERT_TRUE(bank_->enable().ok());
+  run_ms(200);
+  EXPECT_FALSE(bus_->drive(0).operation_enabled());
+  EXPECT_NE(bank_->status(0).drive, hal::DriveState::kEnabled);
+  // WHEN the operator resets the faults with the cause still there THEN it is tried again and found again
+  ASSERT_TRUE(bank_->reset_faults().ok());
+  EXPECT_FALSE(bank_->status(0).fault);
+  run_ms(200);
+  EXPECT_TRUE(bank_->status(0).fault);
+  EXPECT_NE(bank_->fault_text(0).find("vendor id"), std::string::npos) << bank_->fault_text(0);
+}
+
+TEST_F(CanopenWinchBankTest, RefusedWriteNamesTheAbortCode) {
+  // GIVEN a drive description the device refuses (0x6081 of 0 counts/s)
+  CanWinchBankConfig config = two_winches();
+  config.drive.profile_velocity_mps = 1e-5;  // rounds to 0 counts/s at 2e-4 m per count
+  start(config);
+  ASSERT_TRUE(bank_->open().ok());
+  run_ms(500);
+  // THEN the configuration stops there with the device's abort code
+  EXPECT_TRUE(bank_->status(0).fault);
+  EXPECT_NE(bank_->fault_text(0).find("node 1 SDO write 0x6081:0x00: abort 0x06090030 (invalid value for parameter)"),
+            std::string::npos)
+      << bank_->fault_text(0);
+}
+
+TEST_F(CanopenWinchBankTest, PayoutCrossesTheEncoderZero) {
+  // GIVEN enabled drives, winch 0 at 0.1 m (encoder count 1000 of its 2^25 range 0x6002)
+  start();
+  open_and_enable();
+  ASSERT_NEAR(bank_->status(0).payout_m, 0.1, 1e-12);
+  // WHEN it hauls in to -0.2 m: 0x6004 wraps to 2^25 - 2000
+  ASSERT_TRUE(bank_->set_target_payout(0, -0.2).ok());
+  run_ms(300);
+  ASSERT_EQ(bus_->encoder(0).position_value(), (1u << 25) - 2000u);
+  // THEN the payout is -0.2 m, not +3355 m, and the move finished without a fault
+  EXPECT_NEAR(bank_->status(0).payout_m, -0.2, 1e-12);
+  EXPECT_TRUE(bank_->motion_finished());
+  EXPECT_FALSE(bank_->status(0).fault);
+  // WHEN it pays out again across the zero THEN the count follows
+  ASSERT_TRUE(bank_->set_target_payout(0, 0.3).ok());
+  run_ms(300);
+  EXPECT_NEAR(bank_->status(0).payout_m, 0.3, 1e-12);
+}
+
+TEST_F(CanopenWinchBankTest, EncoderJumpIsALatchedFault) {
+  // GIVEN enabled drives
+  start();
+  open_and_enable();
+  // WHEN encoder 11 jumps by 100 m between two readings (10 ms apart)
+  bus_->winch(0).encoder_offset += 1'000'000;
+  run_ms(50);
+  // THEN winch 0 has a fault naming the node and the jump, its position is
+  // invalid, targets are refused; winch 1 is unaffected
+  const hal::WinchStatus s = bank_->status(0);
+  EXPECT_TRUE(s.fault);
+  EXPECT_FALSE(s.position_valid);
+  EXPECT_NE(bank_->fault_text(0).find("node 11: position jumped by 1000000 counts"), std::string::npos)
+      << bank_->fault_text(0);
+  EXPECT_EQ(bank_->set_target_payout(0, s.payout_m).code(), hal::ErrorCode::kInvalidState);
+  EXPECT_FALSE(bank_->status(1).fault);
+  // AND the fault stays latched though the readings are steady again
+  run_ms(100);
+  EXPECT_TRUE(bank_->status(0).fault);
+  // WHEN the operator resets the faults THEN the position is read afresh and moves are accepted
+  ASSERT_TRUE(bank_->reset_faults().ok());
+  run_ms(50);
+  EXPECT_FALSE(bank_->status(0).fault);
+  EXPECT_TRUE(bank_->status(0).position_valid);
+  EXPECT_EQ(bank_->fault_text(0), "");
+  EXPECT_TRUE(bank_->set_target_payout(0, bank_->status(0).payout_m + 0.1).ok());
+}
+
+TEST_F(CanopenWinchBankTest, MoveLongerThanMaxMoveIsRefused) {
+  // GIVEN enabled drives (max_move 250 m by default)
+  start();
+  open_and_enable();
+  const double start_m = bank_->status(0).payout_m;
+  // WHEN a target 300 m away is asked for THEN it is refused and nothing moves
+  const hal::Status refused = bank_->set_target_payout(0, start_m + 300.0);
+  EXPECT_EQ(refused.code(), hal::ErrorCode::kInvalidArgument);
+  EXPECT_NE(refused.message().find("exceeds max_move"), std::string::npos) << refused.message();
+  run_ms(50);
+  EXPECT_NEAR(bus_->drive(0).position_counts(), 0.0, 1e-9);
+  EXPECT_TRUE(bank_->motion_finished());
+}
+
+TEST_F(CanopenWinchBankTest, LateSetpointAcknowledgementLosesNoTarget) {
+  // GIVEN drives that acknowledge a set-point 40 ms late (four PDO cycles)
+  virtual_robot::DriveDefaults slow;
+  slow.ack_delay_s = 0.040;
+  start(two_winches(), slow);
+  open_and_enable();
+  const double start_m = bank_->status(0).payout_m;
+  // WHEN a first target is followed by a second before the first is acknowledged
+  ASSERT_TRUE(bank_->set_target_payout(0, start_m + 0.4).ok());
+  run_ms(15);
+  ASSERT_TRUE(bank_->set_target_payout(0, start_m + 0.1).ok());
+  // THEN the motion is finished only at the second target, and the drive is there
+  for (int i = 0; i < 200 && !bank_->motion_finished(); ++i) run_ms(5);
+  ASSERT_TRUE(bank_->motion_finished());
+  EXPECT_NEAR(bank_->status(0).payout_m, start_m + 0.1, kEncoderMPerCount);
+  run_ms(200);
+  EXPECT_NEAR(bank_->status(0).payout_m, start_m + 0.1, kEncoderMPerCount);
+}
+
+TEST_F(CanopenWinchBankTest, DrivesQuickStopWhenTheMasterHeartbeatStops) {
+  // GIVEN winch 0 on a long move (4 m at 4 m/s)
+  start();
+  open_and_enable();
+  const auto master_heartbeats = std::count_if(bus_->received().begin(), bus_->received().end(),
+                                               [](const virtual_robot::BusFrame& f) { return f.id == 0x77F; });
+  EXPECT_GE(master_heartbeats, 3);
+  ASSERT_TRUE(bank_->set_target_payout(0, bank_->status(0).payout_m + 4.0).ok());
+  run_ms(200);
+  ASSERT_TRUE(bus_->drive(0).operation_enabled());
+  // WHEN the master falls silent (its process died)
+  const double at_death = bus_->drive(0).position_counts();
+  run_ms(1000, false);
+  // THEN within the consumer time (500 ms) plus the braking (0.1 s from 4 m/s at 40 m/s^2)
+  // the drive is in quick stop at rest, with EMCY 0x8130, and went at most 2.2 m further
+  EXPECT_FALSE(bus_->drive(0).operation_enabled());
+  EXPECT_EQ(bus_->drive(0).statusword() & 0x006F, 0x0007);  // quick stop active (0x605A = 6)
+  EXPECT_TRUE(bus_->drive(0).at_rest());
+  const auto& emcy = bus_->drive(0).emergencies();
+  EXPECT_NE(std::find(emcy.begin(), emcy.end(), 0x8130), emcy.end());
+  const double travelled_m = (bus_->drive(0).position_counts() - at_death) * kDriveMPerCount;
+  EXPECT_LT(travelled_m, 4.0 * 0.5 + 4.0 * 4.0 / (2 * 40.0) + 0.05);
+  EXPECT_LT(bus_->drive(0).position_counts() * kDriveMPerCount, 3.5);  // it did not finish the move
+}
+
+TEST_F(CanopenWinchBankTest, FollowingErrorIsAFaultWithItsEmergency) {
+  // GIVEN enabled drives, winch 0's motor blocked
+  start();
+  open_and_enable();
+  bus_->drive(0).set_blocked(true);
+  // WHEN it is sent 1 m (the demand runs away from the blocked motor)
+  ASSERT_TRUE(bank_->set_target_payout(0, bank_->status(0).payout_m + 1.0).ok());
+  run_ms(200);
+  // THEN the drive faults with EMCY 0x8611 and the message says so
+  EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kFault);
+  EXPECT_NE(bank_->fault_text(0).find("EMCY 0x8611 (following error)"), std::string::npos) << bank_->fault_text(0);
+  EXPECT_NE(bank_->fault_text(0).find("0x603F = 0x8611 (following error)"), std::string::npos) << bank_->fault_text(0);
+  // AND the fault stays: nothing resets it behind the operator's back
+  run_ms(500);
+  EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kFault);
+  // WHEN the operator resets the faults THEN the drive leaves fault but stays disabled
+  ASSERT_TRUE(bank_->quick_stop().ok());  // as the daemon does when a run fails
+  ASSERT_TRUE(bank_->reset_faults().ok());
+  run_ms(150);
+  EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kDisabled);
+  EXPECT_EQ(bank_->fault_text(0), "");
+  // WHEN the operator enables again (motor free) THEN the fault is reset once and the drive enabled
+  bus_->drive(0).set_blocked(false);
+  ASSERT_TRUE(bank_->enable().ok());
+  run_ms(150);
+  EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kEnabled);
+}
+
 TEST_F(CanopenWinchBankTest, SilentNodeIsDeadAfterHeartbeatTimeout) {
   // GIVEN enabled drives
+  start();
   open_and_enable();
   // WHEN node 2 goes silent for less than the 500 ms timeout THEN still alive
-  bus_->drive(1).silent = true;
+  bus_->drive(1).set_silent(true);
   run_ms(300);
   EXPECT_TRUE(bank_->status(1).alive);
   // WHEN silent beyond the timeout THEN dead, finished is false, targets are refused
@@ -128,15 +390,10 @@ TEST_F(CanopenWinchBankTest, SilentNodeIsDeadAfterHeartbeatTimeout) {
 }
 
 TEST_F(CanopenWinchBankTest, QuickStopStopsAMovingDrive) {
-  // GIVEN winch 0 on a long move (1 s)
+  // GIVEN winch 0 on a long move (1 s) WHEN quick-stopped
+  start();
   open_and_enable();
-  ASSERT_TRUE(bank_->set_target_payout(0, bank_->status(0).payout_m + 4.0).ok());
-  run_ms(100);
-  // WHEN quick-stopped
-  ASSERT_TRUE(bank_->quick_stop().ok());
-  run_ms(20);
-  const double stopped_m = bank_->status(0).payout_m;
-  run_ms(200);
+  const double stopped_m = quick_stop_during_a_long_move();
   // THEN both drives are in quick stop and winch 0 did not move on
   EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kQuickStop);
   EXPECT_EQ(bank_->status(1).drive, hal::DriveState::kQuickStop);
@@ -148,31 +405,39 @@ TEST_F(CanopenWinchBankTest, QuickStopStopsAMovingDrive) {
   EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kEnabled);
 }
 
-TEST_F(CanopenWinchBankTest, EnableResetsAFault) {
-  // GIVEN a drive that reports a fault
-  ASSERT_TRUE(bank_->open().ok());
-  run_ms(50);
-  bus_->drive(0).power = cia402::PowerState::kFault;
-  run_ms(20);
-  ASSERT_EQ(bank_->status(0).drive, hal::DriveState::kFault);
-  // WHEN enabled THEN the fault is reset and the drive enabled
+TEST_F(CanopenWinchBankTest, QuickStopEndingSwitchedOffIsHandledToo) {
+  // GIVEN drives whose quick stop ends in switch on disabled (0x605A = 2), winch 0 on a long move
+  CanWinchBankConfig config = two_winches();
+  config.drive.quick_stop_option = 2;
+  start(config);
+  open_and_enable();
+  EXPECT_EQ(bus_->drive(0).od().get(0x605A, 0), 2u);
+  // WHEN quick-stopped
+  const double stopped_m = quick_stop_during_a_long_move();
+  // THEN the drives are off, nothing moves, and the bank does not fight the ending
+  EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kDisabled);
+  EXPECT_EQ(bus_->drive(0).statusword() & 0x004F, 0x0040);  // switch on disabled
+  EXPECT_DOUBLE_EQ(bank_->status(0).payout_m, stopped_m);
+  // WHEN enabled again THEN it comes back
   ASSERT_TRUE(bank_->enable().ok());
   run_ms(100);
   EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kEnabled);
 }
 
-TEST_F(CanopenWinchBankTest, RebootedDriveIsStartedButNotReEnabled) {
+TEST_F(CanopenWinchBankTest, RebootedDriveIsReconfiguredButNotReEnabled) {
   // GIVEN enabled drives
+  start();
   open_and_enable();
-  // WHEN drive 1 reboots (boot-up, pre-operational, switch on disabled)
-  test::FakeCanopenBus::Drive& d = bus_->drive(0);
-  d.booted_us = -1;
-  d.nmt = NmtState::kPreOperational;
-  d.power = cia402::PowerState::kSwitchOnDisabled;
-  run_ms(300);
-  // THEN the bank started it again (NMT) but left it disabled, and motion is not finished
-  EXPECT_EQ(d.nmt, NmtState::kOperational);
-  EXPECT_EQ(d.power, cia402::PowerState::kSwitchOnDisabled);
+  // WHEN drive 1 reboots (boot-up, every object back to its default)
+  bus_->drive(0).power_on_reset();
+  ASSERT_EQ(bus_->drive(0).od().get(0x1600, 1), 0x60400010u);
+  ASSERT_EQ(bus_->drive(0).od().get(0x1600, 0), 1u);
+  run_ms(500);
+  // THEN the bank configured and started it again but left it disabled
+  EXPECT_EQ(bus_->drive(0).state(), virtual_robot::NodeState::kOperational);
+  EXPECT_EQ(bus_->drive(0).od().get(0x1600, 2), 0x607A0020u);
+  EXPECT_FALSE(bus_->drive(0).operation_enabled());
+  EXPECT_TRUE(bank_->status(0).alive);
   EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kDisabled);
   EXPECT_FALSE(bank_->motion_finished());
   // WHEN enable() is called THEN it comes back
@@ -183,6 +448,7 @@ TEST_F(CanopenWinchBankTest, RebootedDriveIsStartedButNotReEnabled) {
 
 TEST_F(CanopenWinchBankTest, LostPeerIsNotConnected) {
   // GIVEN an open bank WHEN the far end closes
+  start();
   open_and_enable();
   bus_.reset();
   // THEN update() reports the lost connection
@@ -198,6 +464,11 @@ TEST(CanopenWinchBankConfig, RejectsSharedNodeIdsAndZeroScales) {
   EXPECT_NE(validate(config).find("encoder_m_per_count"), std::string::npos);
   config.winches = {{1, 11, 1e-4, 1e-4}};
   EXPECT_EQ(validate(config), "");
+  config.master_node_id = 11;
+  EXPECT_NE(validate(config).find("master node id 11 also used"), std::string::npos) << validate(config);
+  config.master_node_id = 127;
+  config.drive.consumer_heartbeat_us = config.master_heartbeat_us;
+  EXPECT_NE(validate(config).find("consumer heartbeat"), std::string::npos) << validate(config);
 }
 
 TEST(CanConnector, EndpointsSelectTheTransport) {

@@ -40,6 +40,16 @@ class FakeWinchBank final : public hal::WinchBank {
   void silence(int winch, bool silent = true) { at(winch).silent = silent; }
   // The drive goes to fault at the next update() and stops.
   void inject_fault(int winch) { at(winch).inject_fault = true; }
+  // The operator's reset: a drive in fault goes to disabled.
+  hal::Status reset_faults() override {
+    if (hal::Status s = check_command(); !s.ok()) return s;
+    for (Winch& w : winches_) {
+      if (w.state == hal::DriveState::kFault) w.state = hal::DriveState::kDisabled;
+    }
+    ++fault_resets_;
+    return hal::Status::Ok();
+  }
+  int fault_resets() const { return fault_resets_; }
   // Every command and update() fails with `error` until cleared with Ok().
   void fail_io(hal::Status error) { io_error_ = std::move(error); }
 
@@ -163,6 +173,7 @@ class FakeWinchBank final : public hal::WinchBank {
     bool moved = false;
     hal::TimeUs last_heard_us = -1;
   };
+  int fault_resets_ = 0;
 
   Winch& at(int winch) {
     if (winch < 0 || winch >= options_.winch_count) std::abort();  // as the real bank: broken invariant

@@ -23,24 +23,14 @@ class PlannedWaypoints : public ::testing::TestWithParam<calibration::WaypointSe
 
 TEST_P(PlannedWaypoints, TheTrueLargeRobotRestsNearEveryWaypointPlannedFromNominalAnchors) {
   // GIVEN the virtual robot of the full calibration test (large, nominal anchors 0.3 m off), at rest where it starts
-  const virtual_robot::VirtualRobotOptions robot_options = large_robot_acceptance_options();
-  const auto data = sim::simulate_dataset(virtual_robot::dataset_config(robot_options));
-  ASSERT_TRUE(data) << data.error();
-  const sim::TrueRobot& truth = data->true_robot;
-  const Eigen::Vector3d start_world = virtual_robot::start_position_world(robot_options.preset);
-  const auto start = sim::solve_equilibrium(truth, start_world, 0.0);
-  ASSERT_TRUE(start) << start.error().message;
-  std::array<double, kCableCount> encoder_m{};
-  for (int i = 0; i < kCableCount; ++i) encoder_m[i] = start->cables[i].payout_m + truth.encoder_offset_m[i];
-
   // WHEN the daemon (default settings, but the selection) estimates the offsets there and plans
-  const auto offsets = calibration::estimate_payout_offsets(data->nominal, start_world, encoder_m);
-  ASSERT_TRUE(offsets) << offsets.error();
-  calibration::PlannerOptions options = daemon::default_daemon_config().calibrator.planner;
-  options.selection = GetParam();
-  const auto plan = calibration::plan_waypoints(data->nominal, *offsets, start_world, options);
+  const auto planned = plan_acceptance_robot(GetParam());
+  ASSERT_TRUE(planned);
+  const calibration::WaypointPlan& plan = planned->plan;
   ASSERT_TRUE(plan.ok()) << plan.problem;
-  ASSERT_EQ(static_cast<int>(plan.waypoints.size()), options.waypoint_count);
+  ASSERT_EQ(static_cast<int>(plan.waypoints.size()), daemon::default_daemon_config().calibrator.planner.waypoint_count);
+  const sim::TrueRobot& truth = planned->data.true_robot;
+  const Eigen::Vector3d& start_world = planned->start_world;
 
   // THEN the virtual robot's true physics, driven through the waypoints in order, rests within 1 m of
   // each planned pose

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -21,9 +22,13 @@
 #include "drivers/common/load_cell_reader.h"
 #include "drivers/modbus/modbus_load_cell.h"
 #include "drivers/pose/pose_stream_source.h"
+#include "sim/dataset.h"
+#include "sim/equilibrium.h"
+#include "src/calibration/waypoint_planner.h"
 #include "src/daemon/daemon_loop.h"
 #include "src/daemon/load_cell_presets.h"
 #include "src/load_cell_driver_config.h"
+#include "src/winch_bank_config.h"
 #include "virtual-robot/virtual_robot.h"
 
 namespace cdpr::integration {
@@ -63,6 +68,9 @@ inline daemon::DaemonConfig fast_daemon_config(const std::string& dir, const vir
   // a stall of a few hundred ms is the test machine, not a fault under test
   // (the fault tests with injected clocks cover silent nodes and stale poses).
   config.winches.heartbeat_timeout_us = 3'000'000;
+  // Simulated time runs faster: a 2 m/s cable pays out 2 x time_scale m per real second.
+  config.winches.max_speed_mps = 5.0 * robot.time_scale();
+  config.winches.drive.consumer_heartbeat_us = 3'000'000;
   config.calibrator.monitor.pose_stale_us = 3'000'000;
   return config;
 }
@@ -93,6 +101,43 @@ inline virtual_robot::VirtualRobotOptions large_robot_acceptance_options() {
   return options;
 }
 
+// The acceptance robot's true and nominal data and the daemon's plan for it
+// (default planner settings but the selection), made as the daemon makes it
+// at the start position: offsets estimated there, waypoints planned from
+// the nominal anchors. Failures are test failures (check plan.ok()).
+struct PlannedAcceptanceRobot {
+  sim::SimulatedDataset data;
+  Eigen::Vector3d start_world = Eigen::Vector3d::Zero();
+  calibration::WaypointPlan plan;
+};
+
+inline std::optional<PlannedAcceptanceRobot> plan_acceptance_robot(calibration::WaypointSelection selection) {
+  const virtual_robot::VirtualRobotOptions robot_options = large_robot_acceptance_options();
+  auto data = sim::simulate_dataset(virtual_robot::dataset_config(robot_options));
+  if (!data) {
+    ADD_FAILURE() << data.error();
+    return std::nullopt;
+  }
+  const sim::TrueRobot& truth = data->true_robot;
+  const Eigen::Vector3d start_world = virtual_robot::start_position_world(robot_options.preset);
+  const auto start = sim::solve_equilibrium(truth, start_world, 0.0);
+  if (!start) {
+    ADD_FAILURE() << start.error().message;
+    return std::nullopt;
+  }
+  std::array<double, kCableCount> encoder_m{};
+  for (int i = 0; i < kCableCount; ++i) encoder_m[i] = start->cables[i].payout_m + truth.encoder_offset_m[i];
+  const auto offsets = calibration::estimate_payout_offsets(data->nominal, start_world, encoder_m);
+  if (!offsets) {
+    ADD_FAILURE() << offsets.error();
+    return std::nullopt;
+  }
+  calibration::PlannerOptions options = daemon::default_daemon_config().calibrator.planner;
+  options.selection = selection;
+  calibration::WaypointPlan plan = calibration::plan_waypoints(data->nominal, *offsets, start_world, options);
+  return PlannedAcceptanceRobot{std::move(*data), start_world, std::move(plan)};
+}
+
 class VirtualRobotRig {
  public:
   // `before_start` runs once the robot is up, the configuration made and the
@@ -114,13 +159,8 @@ class VirtualRobotRig {
     store = std::make_unique<store::CalibrationStore>(config.store);
     EXPECT_TRUE(store->open());
     if (before_start) before_start(*this);
-    drivers::can::CanWinchBankConfig winch_config;
-    winch_config.heartbeat_timeout_us = config.winches.heartbeat_timeout_us;
-    for (const daemon::WinchNodes& w : config.winches.winches) {
-      winch_config.winches.push_back({w.drive_node_id, w.encoder_node_id, w.encoder_m_per_count, w.drive_m_per_count});
-    }
     winches = std::make_unique<drivers::can::CanopenWinchBank>(
-        winch_config, drivers::can::make_can_connector(config.winches.endpoint));
+        winch_bank_config(config.winches), drivers::can::make_can_connector(config.winches.endpoint));
     load_cell = std::make_unique<drivers::modbus::ModbusLoadCell>(daemon::load_cell_driver_config(config.load_cell),
                                                                   clock);
     load_cell_reader = std::make_unique<drivers::LoadCellReader>(

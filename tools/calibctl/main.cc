@@ -116,6 +116,7 @@ int main(int argc, char** argv) {
   app.add_subcommand("history", "the stored calibrations, newest first (* = current)");
   app.add_subcommand("commit",
                      "commit the calibration a failed commit kept in <state>/pending, once its cause is fixed");
+  app.add_subcommand("reset-faults", "clear the devices' latched faults once their cause is fixed (not during a run)");
   auto* rollback = app.add_subcommand("rollback", "make stored calibration SEQ current again");
   rollback->add_option("seq", options.seq, "sequence number (see history)")->required()->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);

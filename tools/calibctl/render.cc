@@ -33,6 +33,7 @@ std::string render_status(const JsonValue& s) {
   out += "\n";
   append_if(out, "detail", s["detail"]);
   append_if(out, "note", s["note"]);
+  append_if(out, "faults", s["device_faults"]);
   append_if(out, "reason", s["reason"]);
   if (s["committed_seq"].integer() > 0) out += format("  committed: calibration %d\n", s["committed_seq"].integer());
   append_if(out, "interrupted", s["interrupted"]);

@@ -1,29 +1,29 @@
 #pragma once
-// The virtual robot's CANopen nodes: per winch one CiA 402 drive (profile
-// position mode) and one CiA 406 cable encoder, with exactly the PDO layout
-// the drivers expect (drivers/can/canopen.h) and the device side of the
-// CiA 402 power state machine (drivers/can/cia402.h), so both ends share
-// one definition of the protocol.
+// The virtual robot's CANopen nodes: per winch one CiA 402 drive
+// (cia402_device.h) and one CiA 406 cable encoder (cia406_device.h), each
+// with its own object dictionary and SDO server starting from the
+// profiles' defaults, so cdpr-calibd has to configure them as it would real
+// devices. None of the master's protocol code (drivers/can) is used here:
+// a misreading of the standard on either side shows as a failure.
 //
-// Per node: boot-up heartbeat at construction, pre-operational until an NMT
-// start, heartbeats every heartbeat_period_us, PDOs only when operational.
-// Drives: a rising edge of controlword bit 4 in operation enabled takes the
-// target (setpoint acknowledge bit 12 while bit 4 stays high); target
-// reached (bit 10) once the winch is there; halt (bit 8), quick stop and
-// leaving operation enabled stop the winch where it is.
-// Counts: drive position = payout / drive_m_per_count; encoder position =
-// (payout + encoder noise) / encoder_m_per_count.
-// Time: real monotonic [us] passed in. Not thread-safe.
+// The drives own the winch motion: each runs its own profile (0x6081,
+// 0x6083, 0x6084) in simulated time and the physics follows their
+// positions. Counts: drive position = payout / drive_m_per_count (same
+// zero); encoder position = (payout + noise) / encoder_m_per_count, reported
+// modulo the encoder's measuring range.
+// Time: on_frame/poll take real monotonic [us] (heartbeats, PDO timers,
+// consumer heartbeat); advance() takes simulated seconds. Not thread-safe.
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "drivers/can/can_frame.h"
-#include "drivers/can/canopen.h"
-#include "drivers/can/cia402.h"
 #include "hal/clock.h"
 #include "sim/rng.h"
+#include "virtual-robot/cia402_device.h"
+#include "virtual-robot/cia406_device.h"
 #include "virtual-robot/robot_physics.h"
 
 namespace cdpr::virtual_robot {
@@ -33,8 +33,8 @@ struct NodeLayout {
   std::array<int, kCableCount> encoder_node_id{11, 12, 13, 14};
   double encoder_m_per_count = 1.0e-5;
   double drive_m_per_count = 1.0e-5;
-  hal::TimeUs heartbeat_period_us = 100'000;
-  hal::TimeUs pdo_period_us = 10'000;
+  std::uint32_t encoder_range_counts = 1u << 26;  // 0x6002: 671 m at 1e-5 m per count
+  std::int8_t drive_power_on_mode = 0;            // 0x6060 at power on: 0 none, 1 profile position, 6 homing
   double encoder_noise_m = 0.0;  // 1-sigma per reading [m]
 };
 
@@ -42,40 +42,27 @@ class CanopenNodes {
  public:
   CanopenNodes(const NodeLayout& layout, RobotPhysics& physics, sim::Rng rng, hal::TimeUs now_us);
 
-  // A frame from the bus (the daemon): NMT or a drive RxPDO; others ignored.
-  void on_frame(const drivers::can::CanFrame& frame);
-  // Appends the frames due at `now_us` (heartbeats, PDOs).
+  // A frame from the bus (the daemon).
+  void on_frame(const drivers::can::CanFrame& frame, hal::TimeUs now_us);
+  // Moves the drives by dt_s simulated seconds and the physics' payouts with them.
+  void advance(double dt_s);
+  // Appends the frames due at `now_us`.
   void poll(hal::TimeUs now_us, std::vector<drivers::can::CanFrame>& out);
 
   // Node `id` stops talking (heartbeat and PDOs), as a cut cable would.
   void silence(int node_id, bool silent);
+  // Every drive at rest (no profile running).
+  bool winches_still() const;
+  Cia402Device& drive(int winch) { return *drives_[winch]; }
+  Cia406Device& encoder(int winch) { return *encoders_[winch]; }
 
  private:
-  struct Node {
-    int id = 0;
-    drivers::can::NmtState nmt = drivers::can::NmtState::kPreOperational;
-    bool boot_up_pending = true;
-    bool silent = false;
-    hal::TimeUs next_heartbeat_us = 0;
-  };
-  struct Drive {
-    Node node;
-    Node encoder;
-    drivers::can::cia402::PowerState power = drivers::can::cia402::PowerState::kSwitchOnDisabled;
-    std::uint16_t controlword = 0;
-    bool setpoint_ack = false;
-  };
-
-  void on_rxpdo(int winch, const drivers::can::DriveRxPdo& pdo);
-  void on_nmt(const drivers::can::NmtCommandFrame& command);
-  void heartbeat(Node& node, hal::TimeUs now_us, std::vector<drivers::can::CanFrame>& out);
-  std::uint16_t statusword(int winch) const;
-
   NodeLayout layout_;
   RobotPhysics& physics_;
   sim::Rng rng_;
-  std::array<Drive, kCableCount> drives_{};
-  hal::TimeUs next_pdo_us_ = 0;
+  std::array<std::unique_ptr<Cia402Device>, kCableCount> drives_;
+  std::array<std::unique_ptr<Cia406Device>, kCableCount> encoders_;
+  std::vector<BusFrame> scratch_;
 };
 
 }  // namespace cdpr::virtual_robot

@@ -45,6 +45,9 @@ class RobotPhysics {
   void set_target(int winch, double payout_m) { target_m_[winch] = payout_m; }
   // Drive i stops where it is (halt, quick stop, power off).
   void stop(int winch) { target_m_[winch] = payout_m_[winch]; }
+  // Winch i is at `payout_m` now: its drive runs its own profile (the
+  // virtual robot's CiA 402 drives), the physics only follows.
+  void set_payout(int winch, double payout_m) { payout_m_[winch] = target_m_[winch] = payout_m; }
   void advance(double dt_s);
 
   double payout_m(int winch) const { return payout_m_[winch]; }

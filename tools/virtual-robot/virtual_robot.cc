@@ -114,7 +114,9 @@ void VirtualRobot::run_once(hal::TimeUs max_wait_us) {
   }
   const hal::TimeUs now_us = clock_.now_us();
   modbus_->service(fds_, now_us);  // also sends replies whose latency has passed
-  physics_->advance(options_.time_scale * 1e-6 * static_cast<double>(now_us - last_us_));
+  const double dt_s = options_.time_scale * 1e-6 * static_cast<double>(now_us - last_us_);
+  nodes_->advance(dt_s);
+  physics_->advance(dt_s);
   last_us_ = now_us;
   for (int i = 0; i < kCableCount; ++i) payout_snapshot_m_[i].store(physics_->payout_m(i));
   publish(now_us);
@@ -127,7 +129,7 @@ void VirtualRobot::on_can_bytes(int client, std::string_view bytes) {
   for (; partial.size() - used >= drivers::can::kWireFrameBytes; used += drivers::can::kWireFrameBytes) {
     drivers::can::CanFrame frame;
     if (drivers::can::decode_wire_frame(reinterpret_cast<const std::uint8_t*>(partial.data() + used), frame)) {
-      nodes_->on_frame(frame);
+      nodes_->on_frame(frame, clock_.now_us());
     }
   }
   partial.erase(0, used);
@@ -148,8 +150,7 @@ void VirtualRobot::publish(hal::TimeUs now_us) {
   const double k = options_.noise_scale;
   // Load cell: the cell calls its reading stable once it stops changing.
   const int reference = robot.reference_cable;
-  bool winches_still = true;
-  for (int i = 0; i < kCableCount; ++i) winches_still = winches_still && physics_->at_target(i);
+  const bool winches_still = nodes_->winches_still();
   cell_->set_reading(physics_->tension_n(reference) + k * robot.noise.force_n * noise_.normal(),
                      winches_still && physics_->tension_unsettled_n(reference) < std::max(1.0, robot.noise.force_n),
                      false);

@@ -5,7 +5,8 @@
 //
 //   <dir>/can.sock    CAN frames over a Unix stream socket (the record format
 //                     of drivers/can/fd_can_transport.h): 4 CiA 402 drives and
-//                     4 CiA 406 encoders (canopen_nodes.h)
+//                     4 CiA 406 encoders from their profiles' defaults, which
+//                     the daemon configures over SDO (canopen_nodes.h)
 //   127.0.0.1:<port>  Modbus TCP load cell on the reference cable, or with
 //   <dir>/load_cell.tty  modbus_transport "rtu" a Modbus RTU one on a pty;
 //                     register map per load_cell_model (load_cell_models.h)
@@ -80,6 +81,7 @@ class VirtualRobot {
   std::string pose_endpoint() const { return "unix:" + options_.dir + "/pose.sock"; }
   std::string modbus_endpoint() const { return modbus_->endpoint(); }
   const VirtualRobotOptions& options() const { return options_; }
+  double time_scale() const { return options_.time_scale; }
   const Robot& nominal_robot() const { return data_.nominal; }
   const Truth& truth() const { return data_.truth; }
   const RobotPhysics& physics() const { return *physics_; }

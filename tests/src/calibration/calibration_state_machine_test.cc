@@ -322,6 +322,31 @@ TEST(CalibrationStateMachine, PreflightFailsWhenADriveDoesNotEnable) {
   expect_failed_safely(rig, "winch 1 drive fault");
 }
 
+TEST(CalibrationStateMachine, DeviceFaultsShowUntilTheOperatorResetsThem) {
+  // GIVEN a run that failed on winch 1's drive fault
+  CalibrationRig rig;
+  rig.winches.inject_fault(1);
+  rig.button.press();
+  ASSERT_TRUE(rig.run_to_end());
+  rig.machine->step(rig.clock.now_us());
+  // THEN the status shows the latched fault, and keeps showing it
+  EXPECT_EQ(rig.machine->status().device_faults, "winch 1: drive fault");
+  for (int k = 0; k < 10; ++k) rig.machine->step(rig.clock.now_us());
+  EXPECT_EQ(rig.machine->status().device_faults, "winch 1: drive fault");
+  // WHEN the operator resets the faults THEN the bank is asked to, and the status clears
+  ASSERT_TRUE(rig.machine->request_reset_faults(rig.clock.now_us()));
+  EXPECT_EQ(rig.winches.fault_resets(), 1);
+  EXPECT_NE(rig.machine->status().note.find("were: winch 1: drive fault"), std::string::npos) << rig.machine->status().note;
+  rig.machine->step(rig.clock.now_us());
+  EXPECT_EQ(rig.machine->status().device_faults, "");
+  // AND during a run the request is refused
+  rig.button.press();
+  rig.machine->step(rig.clock.now_us());
+  ASSERT_TRUE(is_running(rig.machine->status().state));
+  EXPECT_FALSE(rig.machine->request_reset_faults(rig.clock.now_us()));
+  EXPECT_NE(rig.machine->status().note.find("refused"), std::string::npos);
+}
+
 TEST(CalibrationStateMachine, AsynchronousSolveIsHandedInByTheOwner) {
   // GIVEN a state machine without a solve function
   CalibrationRig rig;

@@ -24,7 +24,14 @@ TEST(ControlDispatch, StatusOfAnIdleDaemon) {
   EXPECT_EQ(ask(rig, "status"),
             "{\"ok\":true,\"state\":\"idle\",\"running\":false,\"waypoint\":0,\"waypoints\":0,\"samples\":0,"
             "\"skipped\":0,\"progress\":0,\"elapsed_s\":null,\"reason\":\"\",\"note\":\"\",\"detail\":\"\","
-            "\"committed_seq\":0,\"interrupted\":\"\",\"store_problems\":[],\"pending_commit\":false}\n");
+            "\"device_faults\":\"\",\"committed_seq\":0,\"interrupted\":\"\",\"store_problems\":[],\"pending_commit\":false}\n");
+}
+
+TEST(ControlDispatch, ResetFaultsReachesTheWinchBank) {
+  // GIVEN an idle daemon WHEN asked to reset the faults THEN the bank is asked to, and the answer says so
+  CalibrationRig rig;
+  EXPECT_EQ(ask(rig, "reset-faults"), "{\"ok\":true,\"message\":\"faults reset (there were none)\"}\n");
+  EXPECT_EQ(rig.winches.fault_resets(), 1);
 }
 
 TEST(ControlDispatch, StartTwiceAbortAndRollbackWhileRunning) {

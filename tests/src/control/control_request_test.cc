@@ -14,6 +14,7 @@ TEST(ControlRequest, EveryCommandParses) {
   EXPECT_EQ(parse_request("status\r\n")->kind, RequestKind::kStatus);
   EXPECT_EQ(parse_request("  show \t")->kind, RequestKind::kShow);
   EXPECT_EQ(parse_request("history")->kind, RequestKind::kHistory);
+  EXPECT_EQ(parse_request("reset-faults")->kind, RequestKind::kResetFaults);
   const auto rollback = parse_request("rollback   42\n");
   ASSERT_TRUE(rollback);
   EXPECT_EQ(rollback->kind, RequestKind::kRollback);
@@ -23,7 +24,8 @@ TEST(ControlRequest, EveryCommandParses) {
 TEST(ControlRequest, MistakesAreRefusedWithAReason) {
   // GIVEN malformed requests WHEN parsed THEN each error says what is wrong
   EXPECT_EQ(parse_request("strat").error(),
-            "unknown command 'strat' (expected start, abort, status, show, history, rollback <seq> or commit)");
+            "unknown command 'strat' (expected start, abort, status, show, history, rollback <seq>, "
+            "commit or reset-faults)");
   EXPECT_EQ(parse_request("").error().substr(0, 13), "empty request");
   EXPECT_EQ(parse_request("START").error().substr(0, 15), "unknown command");
   EXPECT_EQ(parse_request("start now").error(), "start takes no argument");

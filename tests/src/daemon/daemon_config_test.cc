@@ -32,6 +32,18 @@ TEST(DaemonConfig, TheShippedExampleParsesToTheDefaults) {
     EXPECT_EQ(config->winches.winches[i].encoder_m_per_count, defaults.winches.winches[i].encoder_m_per_count);
   }
   EXPECT_EQ(config->winches.heartbeat_timeout_us, defaults.winches.heartbeat_timeout_us);
+  EXPECT_EQ(config->winches.max_move_m, defaults.winches.max_move_m);
+  EXPECT_EQ(config->winches.master_node_id, defaults.winches.master_node_id);
+  EXPECT_EQ(config->winches.master_heartbeat_us, defaults.winches.master_heartbeat_us);
+  EXPECT_EQ(config->winches.sdo_timeout_us, defaults.winches.sdo_timeout_us);
+  const CanDriveDescription& drive = config->winches.drive;
+  EXPECT_EQ(drive.quick_stop_option, defaults.winches.drive.quick_stop_option);
+  EXPECT_EQ(drive.abort_connection_option, defaults.winches.drive.abort_connection_option);
+  EXPECT_EQ(drive.profile_velocity_mps, defaults.winches.drive.profile_velocity_mps);
+  EXPECT_EQ(drive.quick_stop_deceleration_mps2, defaults.winches.drive.quick_stop_deceleration_mps2);
+  EXPECT_EQ(drive.consumer_heartbeat_us, defaults.winches.drive.consumer_heartbeat_us);
+  EXPECT_EQ(drive.pdo_event_timer_us, defaults.winches.drive.pdo_event_timer_us);
+  EXPECT_EQ(config->winches.encoder.pdo_event_timer_us, defaults.winches.encoder.pdo_event_timer_us);
   EXPECT_EQ(config->load_cell.endpoint, defaults.load_cell.endpoint);
   EXPECT_EQ(config->load_cell.response_timeout_us, defaults.load_cell.response_timeout_us);
   EXPECT_EQ(config->pose.endpoint, defaults.pose.endpoint);
@@ -60,6 +72,13 @@ group = "robot-operators"
 period_ms = 10
 [winches]
 endpoint = "unix:/tmp/can.sock"
+master_heartbeat_ms = 50
+[winches.drive]
+vendor_id = 0x9A
+consumer_heartbeat_ms = 200
+profile_velocity_mps = 1.5
+[winches.encoder]
+pdo_event_timer_ms = 5
 [load_cell]
 endpoint = "tcp:127.0.0.1:1502"
 parity = "E"
@@ -85,6 +104,11 @@ accept_max_iterations = true
   EXPECT_EQ(config->control_socket_group, "robot-operators");
   EXPECT_EQ(config->loop_period_us, 10'000);
   EXPECT_EQ(config->winches.endpoint, "unix:/tmp/can.sock");
+  EXPECT_EQ(config->winches.master_heartbeat_us, 50'000);
+  EXPECT_EQ(config->winches.drive.vendor_id, 0x9A);
+  EXPECT_EQ(config->winches.drive.consumer_heartbeat_us, 200'000);
+  EXPECT_EQ(config->winches.drive.profile_velocity_mps, 1.5);
+  EXPECT_EQ(config->winches.encoder.pdo_event_timer_us, 5'000);
   EXPECT_EQ(config->load_cell.parity, 'E');
   // the preset's map, with the keys beside it overriding
   EXPECT_EQ(config->load_cell.preset, "flintec-ft-11");
@@ -126,6 +150,10 @@ TEST(DaemonConfig, RefusesBadInputNamingLineAndKey) {
       {"robot = \"r\"\n[control]\ngroup = \"-x\"\n", 3, "control.group"},                // option-like name
       {"robot = \"r\"\n[control]\ngroup = 1000\n", 3, "control.group"},                    // not a string
       {"robot = \"r\"\n[control]\ngroup = \"\"\n", 3, "control.group"},                  // empty
+      {"robot = \"r\"\n[winches.drive]\nquick_stop_option = 3\n", 3, "winches.drive.quick_stop_option"},
+      {"robot = \"r\"\n[winches.drive]\nconsumer_heartbeat_ms = 100\n", 3,
+       "winches.drive.consumer_heartbeat_ms"},  // not above the master's heartbeat period
+      {"robot = \"r\"\n[winches.drive]\nvendor_id = -1\n", 3, "winches.drive.vendor_id"},
   };
   for (const Case& c : cases) {
     // GIVEN a configuration with one mistake WHEN parsed

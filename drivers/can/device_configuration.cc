@@ -1,0 +1,130 @@
+#include "drivers/can/device_configuration.h"
+
+#include <cmath>
+#include <string>
+
+namespace cdpr::drivers::can {
+namespace {
+
+using Kind = SdoStep::Kind;
+constexpr std::uint32_t kInvalid = 0x80000000u;
+
+std::uint32_t mapping(std::uint16_t index, std::uint8_t subindex, std::uint8_t bits) {
+  return static_cast<std::uint32_t>(index) << 16 | static_cast<std::uint32_t>(subindex) << 8 | bits;
+}
+
+std::uint32_t milliseconds(hal::TimeUs us) { return static_cast<std::uint32_t>(us / 1000); }
+
+std::uint32_t counts(double metres, double m_per_count) {
+  return static_cast<std::uint32_t>(std::llround(metres / std::abs(m_per_count)));
+}
+
+void identity(std::vector<SdoStep>& steps, std::uint32_t vendor, std::uint32_t product) {
+  if (vendor != 0) steps.push_back({Kind::kExpect, 0x1018, 1, 4, vendor, "vendor id"});
+  if (product != 0) steps.push_back({Kind::kExpect, 0x1018, 2, 4, product, "product code"});
+}
+
+// One PDO: invalid, mapping cleared, entries, count, transmission type,
+// event timer (TPDOs), valid on `cob_id`.
+void pdo(std::vector<SdoStep>& steps, bool transmit, int number, std::uint32_t cob_id,
+         const std::vector<std::uint32_t>& entries, std::uint8_t type, std::uint32_t event_ms) {
+  const auto communication = static_cast<std::uint16_t>((transmit ? 0x1800 : 0x1400) + number - 1);
+  const auto map = static_cast<std::uint16_t>(communication + 0x200);
+  const char* cob = transmit ? "TPDO COB-ID" : "RPDO COB-ID";
+  steps.push_back({Kind::kWrite, communication, 1, 4, kInvalid | cob_id, cob});
+  steps.push_back({Kind::kWriteVerify, map, 0, 1, 0, "PDO mapping count"});
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    steps.push_back({Kind::kWriteVerify, map, static_cast<std::uint8_t>(i + 1), 4, entries[i], "PDO mapping entry"});
+  }
+  steps.push_back({Kind::kWriteVerify, map, 0, 1, static_cast<std::uint32_t>(entries.size()), "PDO mapping count"});
+  steps.push_back({Kind::kWriteVerify, communication, 2, 1, type, "PDO transmission type"});
+  if (transmit) {
+    // Changes (a moving position changes every cycle) at most 4 times per event period.
+    steps.push_back({Kind::kWriteVerify, communication, 3, 2, event_ms * 10 / 4, "TPDO inhibit time"});
+    steps.push_back({Kind::kWriteVerify, communication, 5, 2, event_ms, "TPDO event timer"});
+  }
+  steps.push_back({Kind::kWriteVerify, communication, 1, 4, cob_id, cob});
+}
+
+void disable_pdos(std::vector<SdoStep>& steps, int node_id, bool receive) {
+  const auto id = static_cast<std::uint32_t>(node_id);
+  for (int n = 1; n < 4; ++n) {
+    const auto offset = static_cast<std::uint32_t>(0x100 * n);
+    if (receive) {
+      steps.push_back({Kind::kWriteVerify, static_cast<std::uint16_t>(0x1400 + n), 1, 4,
+                       kInvalid | (0x200 + offset + id), "unused RPDO COB-ID"});
+    }
+    steps.push_back({Kind::kWriteVerify, static_cast<std::uint16_t>(0x1800 + n), 1, 4, kInvalid | (0x180 + offset + id),
+                     "unused TPDO COB-ID"});
+  }
+}
+
+}  // namespace
+
+std::string validate(const DriveDescription& d) {
+  const int q = d.quick_stop_option;
+  if (q != 0 && q != 1 && q != 2 && q != 5 && q != 6) return "quick_stop_option must be 0, 1, 2, 5 or 6";
+  if (d.abort_connection_option < 0 || d.abort_connection_option > 3) return "abort_connection_option must be 0..3";
+  for (double v : {d.following_error_window_m, d.profile_velocity_mps, d.profile_acceleration_mps2,
+                   d.profile_deceleration_mps2, d.quick_stop_deceleration_mps2}) {
+    if (!(v > 0.0) || !std::isfinite(v)) return "following error window, profile and quick-stop values must be positive";
+  }
+  if (d.position_limit_min_counts >= d.position_limit_max_counts) return "position limits: min must be below max";
+  if (d.heartbeat_producer_us < 1000 || d.heartbeat_producer_us > 65'535'000) return "heartbeat producer time out of 1..65535 ms";
+  if (d.consumer_heartbeat_us < 1000 || d.consumer_heartbeat_us > 65'535'000) return "consumer heartbeat time out of 1..65535 ms";
+  if (d.pdo_event_timer_us < 1000 || d.pdo_event_timer_us > 65'535'000) return "PDO event timer out of 1..65535 ms";
+  return {};
+}
+
+std::string validate(const EncoderDescription& e) {
+  if (e.heartbeat_producer_us < 1000 || e.heartbeat_producer_us > 65'535'000) return "heartbeat producer time out of 1..65535 ms";
+  if (e.pdo_event_timer_us < 1000 || e.pdo_event_timer_us > 65'535'000) return "PDO event timer out of 1..65535 ms";
+  return {};
+}
+
+std::vector<SdoStep> drive_configuration(int node_id, int master_node_id, double m_per_count,
+                                         const DriveDescription& d) {
+  const auto id = static_cast<std::uint32_t>(node_id);
+  std::vector<SdoStep> steps;
+  identity(steps, d.vendor_id, d.product_code);
+  pdo(steps, false, 1, 0x200 + id, {mapping(0x6040, 0, 16), mapping(0x607A, 0, 32)}, 255, 0);
+  pdo(steps, true, 1, 0x180 + id, {mapping(0x6041, 0, 16), mapping(0x6064, 0, 32)}, 255,
+      milliseconds(d.pdo_event_timer_us));
+  disable_pdos(steps, node_id, true);
+  steps.push_back({Kind::kWriteVerify, 0x605A, 0, 2, static_cast<std::uint32_t>(d.quick_stop_option), "quick stop option code"});
+  steps.push_back({Kind::kWriteVerify, 0x6007, 0, 2, static_cast<std::uint32_t>(d.abort_connection_option),
+                   "abort connection option code"});
+  steps.push_back({Kind::kWriteVerify, 0x6065, 0, 4, counts(d.following_error_window_m, m_per_count), "following error window"});
+  steps.push_back({Kind::kWriteVerify, 0x607D, 1, 4, static_cast<std::uint32_t>(d.position_limit_min_counts),
+                   "software position limit min"});
+  steps.push_back({Kind::kWriteVerify, 0x607D, 2, 4, static_cast<std::uint32_t>(d.position_limit_max_counts),
+                   "software position limit max"});
+  steps.push_back({Kind::kWriteVerify, 0x6081, 0, 4, counts(d.profile_velocity_mps, m_per_count), "profile velocity"});
+  steps.push_back({Kind::kWriteVerify, 0x6083, 0, 4, counts(d.profile_acceleration_mps2, m_per_count), "profile acceleration"});
+  steps.push_back({Kind::kWriteVerify, 0x6084, 0, 4, counts(d.profile_deceleration_mps2, m_per_count), "profile deceleration"});
+  steps.push_back({Kind::kWriteVerify, 0x6085, 0, 4, counts(d.quick_stop_deceleration_mps2, m_per_count),
+                   "quick stop deceleration"});
+  steps.push_back({Kind::kWriteVerify, 0x1017, 0, 2, milliseconds(d.heartbeat_producer_us), "producer heartbeat time"});
+  steps.push_back({Kind::kWriteVerify, 0x1016, 1, 4,
+                   static_cast<std::uint32_t>(master_node_id) << 16 | milliseconds(d.consumer_heartbeat_us),
+                   "consumer heartbeat time of the master"});
+  return steps;
+}
+
+std::vector<SdoStep> encoder_configuration(int node_id, const EncoderDescription& e) {
+  const auto id = static_cast<std::uint32_t>(node_id);
+  std::vector<SdoStep> steps;
+  identity(steps, e.vendor_id, e.product_code);
+  pdo(steps, true, 1, 0x180 + id, {mapping(0x6004, 0, 32)}, 254, milliseconds(e.pdo_event_timer_us));
+  disable_pdos(steps, node_id, false);
+  steps.push_back({Kind::kWriteVerify, 0x1017, 0, 2, milliseconds(e.heartbeat_producer_us), "producer heartbeat time"});
+  steps.push_back({Kind::kRead, 0x6002, 0, 4, 0, "total measuring range"});
+  return steps;
+}
+
+std::vector<SdoStep> drive_mode_check() {
+  return {{Kind::kWrite, 0x6060, 0, 1, 1, "modes of operation"},
+          {Kind::kExpect, 0x6061, 0, 1, 1, "modes of operation display (1 = profile position)"}};
+}
+
+}  // namespace cdpr::drivers::can

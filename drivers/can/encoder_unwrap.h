@@ -1,0 +1,47 @@
+#pragma once
+// CiA 406 position value (0x6004) to a continuous count. The encoder reports
+// an UNSIGNED32 that wraps at its total measuring range (0x6002): a payout a
+// few counts below the encoder's zero reads as range - a few. The first
+// reading is taken nearest zero (in [-range/2, range/2)); every later one is
+// unwrapped as the shortest way round from the previous reading. A change
+// larger than the caller says is physically possible since the previous
+// reading is a jump: the reading is refused and the unwrapper stays invalid
+// until reset(), so a corrupted or re-zeroed encoder never becomes a move.
+// Pure logic, no I/O, no allocation.
+
+#include <cstdint>
+
+namespace cdpr::drivers::can {
+
+class EncoderUnwrap {
+ public:
+  // range_counts: positions 0 .. range - 1; 0 means the full 2^32.
+  EncoderUnwrap() = default;
+  explicit EncoderUnwrap(std::uint64_t range_counts) { set_range(range_counts); }
+
+  void set_range(std::uint64_t range_counts);
+  std::uint64_t range() const { return range_; }
+  // Forgets the history (node rebooted, range changed, fault acknowledged).
+  void reset();
+
+  enum class Outcome { kOk, kOutOfRange, kJump };
+  // One reading; max_change_counts bounds |change| since the previous one.
+  Outcome add(std::uint32_t raw, double max_change_counts);
+
+  bool valid() const { return valid_; }
+  std::int64_t counts() const { return counts_; }
+  // The refused change of the last kJump [counts].
+  std::int64_t last_jump_counts() const { return last_jump_counts_; }
+
+ private:
+  std::int64_t nearest(std::int64_t difference) const;
+
+  std::uint64_t range_ = 1ull << 32;
+  bool valid_ = false;
+  bool broken_ = false;
+  std::uint32_t last_raw_ = 0;
+  std::int64_t counts_ = 0;
+  std::int64_t last_jump_counts_ = 0;
+};
+
+}  // namespace cdpr::drivers::can
