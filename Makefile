@@ -11,7 +11,8 @@ comma      := ,
 # Debian packages the project needs; see README.md for why each is here.
 DEB_PACKAGES := build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev \
                 libmodbus-dev libsystemd-dev libtomlplusplus-dev libcli11-dev \
-                libgtest-dev libgmock-dev libbenchmark-dev libgpiod-dev systemd
+                libgtest-dev libgmock-dev libbenchmark-dev libgpiod-dev systemd \
+                libseccomp-dev bubblewrap
 # Ceres is used by the benchmark comparison only, never linked into the daemon.
 BENCH_PACKAGES := libceres-dev
 # clang and its runtimes (libFuzzer, ASan, UBSan) for make fuzz only.
