@@ -10,7 +10,8 @@
 //     sysusers makes them
 //   ProtectSystem=strict, StateDirectory=, RuntimeDirectory=: / read-only
 //     but the state and runtime directories (bwrap --ro-bind / / --bind)
-//   PrivateTmp=: an empty /tmp of its own (--tmpfs /tmp)
+//   PrivateTmp=: an empty /tmp of its own (--tmpfs /tmp), the build
+//     directory bound back in (read-only) should it be under /tmp
 //   CapabilityBoundingSet=, AmbientCapabilities=: none (--cap-drop ALL)
 //   PrivateIPC=, ProtectHostname=: --unshare-ipc, --unshare-uts
 //   UMask=0027
@@ -94,6 +95,8 @@ class SandboxedDaemon {
     std::vector<std::string> args = {
         "bwrap", "--unshare-user", "--uid", id, "--gid", id, "--unshare-ipc", "--unshare-uts",
         "--cap-drop", "ALL", "--die-with-parent", "--ro-bind", "/", "/", "--tmpfs", "/tmp",
+        // The programs, where an installation would have them outside /tmp.
+        "--ro-bind", CDPR_BINARY_DIR, CDPR_BINARY_DIR,
         "--ro-bind", dir, dir, "--bind", dir + "/state", dir + "/state", "--bind", dir + "/run", dir + "/run",
         "--ro-bind", dir + "/passwd", "/etc/passwd", "--ro-bind", dir + "/group", "/etc/group",
         "--info-fd", std::to_string(info[1]), "--",
