@@ -12,9 +12,11 @@ comma      := ,
 DEB_PACKAGES := build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev \
                 libmodbus-dev libsystemd-dev libtomlplusplus-dev libcli11-dev \
                 libgtest-dev libgmock-dev libbenchmark-dev libgpiod-dev systemd \
-                mbpoll
+                mbpoll libseccomp-dev bubblewrap lintian
 # mbpoll: a Modbus master neither the daemon nor the virtual robot shares
-# code with, for the load cell's cross-check test.
+# code with, for the load cell's cross-check test. libseccomp-dev and
+# bubblewrap: the test that runs the daemon in the unit's sandbox. lintian:
+# the package test.
 # Ceres is used by the benchmark comparison only, never linked into the daemon.
 BENCH_PACKAGES := libceres-dev
 # clang and its runtimes (libFuzzer, ASan, UBSan) for make fuzz only.
@@ -24,7 +26,7 @@ FUZZ_BUILD   ?= $(BUILD)-fuzz
 FUZZ_SECONDS ?= 600
 FUZZ_TARGETS ?=
 
-.PHONY: all deps bench-deps configure test sanitize fuzz demo demo-offline bench install clean
+.PHONY: all deps bench-deps configure test sanitize fuzz demo demo-offline bench install deb clean
 
 all: configure
 	cmake --build $(BUILD) -j $(JOBS)
@@ -77,8 +79,13 @@ bench: bench-deps configure
 	cmake --build $(BUILD) -j $(JOBS) --target cdpr-bench
 	$(BUILD)/tools/cdpr-bench
 
+# The unit installed with the daemon names it under $(PREFIX) (systemd/CMakeLists.txt).
 install: all
 	cmake --install $(BUILD) --prefix $(PREFIX)
+
+# $(BUILD)/cdpr-calibration_<version>_<arch>.deb (tools/make-deb.sh, packaging/deb/).
+deb: all
+	cmake --build $(BUILD) --target deb
 
 clean:
 	rm -rf $(BUILD)

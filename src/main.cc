@@ -35,6 +35,7 @@
 #include "src/daemon/instance_lock.h"
 #include "src/formats/robot_toml.h"
 #include "src/winch_bank_config.h"
+#include "version/version.h"
 
 namespace {
 
@@ -91,6 +92,7 @@ std::unique_ptr<hal::Button> open_button(const daemon::ButtonConfig& c) {
 
 int main(int argc, char** argv) {
   CLI::App app{"cdpr-calibd: field self-calibration daemon of a cable-driven parallel robot"};
+  app.set_version_flag("--version", cdpr::version::version_text("cdpr-calibd"));
   std::string config_path = "/etc/cdpr-calib/cdpr-calibd.toml";
   app.add_option("--config,-c", config_path, "configuration file (keys: see the example cdpr-calibd.toml)")
       ->capture_default_str();

@@ -1,6 +1,12 @@
 #!/usr/bin/env bash
 # Installs the Debian packages named on the command line that are not yet
-# installed. Does nothing (and needs no network) when all are present.
+# installed, and nothing else: no installed package is ever upgraded, not
+# even as a dependency (libsystemd-dev needs libsystemd0 of its own version,
+# so installing a newer one would upgrade systemd's library under the running
+# system). apt's plan is simulated first; if it would upgrade anything, it
+# stops and names what, so the upgrade stays the administrator's decision.
+# Does nothing (and needs no network) when all are present.
+# INSTALL_DEPS_DRY_RUN=1: report the plan, install nothing.
 set -euo pipefail
 missing=()
 for pkg in "$@"; do
@@ -8,11 +14,25 @@ for pkg in "$@"; do
   [[ "$status" == "install ok installed" ]] || missing+=("$pkg")
 done
 [[ ${#missing[@]} -eq 0 ]] && exit 0
-echo "install-deps: installing missing Debian packages: ${missing[*]}"
+echo "install-deps: missing Debian packages: ${missing[*]}"
 if [[ $(id -u) -ne 0 ]]; then
   echo "install-deps: need root to install ${missing[*]} (or install them yourself)" >&2
   exit 1
 fi
 export DEBIAN_FRONTEND=noninteractive
+apt_install=(apt-get install -y -qq --no-upgrade --no-install-recommends)
 apt-get update -qq
-apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# Simulated: "Inst <package> [<installed version>] (<new version> ...)" is an upgrade.
+plan=$("${apt_install[@]}" --simulate "${missing[@]}")
+upgrades=$(sed -n 's/^Inst \([^ ]*\) \[\([^]]*\)\] (\([^ ]*\).*/\1 \2 -> \3/p' <<<"$plan")
+if [[ -n $upgrades ]]; then
+  echo "install-deps: installing ${missing[*]} would upgrade installed packages:" >&2
+  sed 's/^/  /' <<<"$upgrades" >&2
+  echo "install-deps: not upgrading anything; upgrade them yourself (apt-get install ${missing[*]}) and rerun" >&2
+  exit 1
+fi
+if [[ -n ${INSTALL_DEPS_DRY_RUN:-} ]]; then
+  echo "install-deps: dry run: would install: $(sed -n 's/^Inst \([^ ]*\) .*/\1/p' <<<"$plan" | tr '\n' ' ')"
+  exit 0
+fi
+"${apt_install[@]}" "${missing[@]}"

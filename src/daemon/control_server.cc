@@ -11,6 +11,7 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <vector>
 
 #include "src/control/control_request.h"
@@ -75,6 +76,24 @@ hal::Result<gid_t> group_id(const std::string& path, const std::string& group) {
                      "control socket " + path + ": group '" + group + "' does not exist");
 }
 
+// The socket takes the group of the daemon (its primary group, or the
+// directory's under a setgid directory) at bind(); chown() is tried only
+// when that is not `gid`. Under the shipped unit it cannot succeed: chown is
+// filtered (SystemCallFilter=~@privileged) and PrivateUsers= leaves other
+// groups unmapped (EINVAL), so the error says how to get the group without it.
+hal::Status give_socket_to_group(const std::string& path, gid_t gid, const std::string& group) {
+  struct stat info {};
+  if (stat(path.c_str(), &info) != 0) return errno_status(path, "stat");
+  if (info.st_gid == gid) return hal::Status::Ok();
+  if (chown(path.c_str(), static_cast<uid_t>(-1), gid) == 0) return hal::Status::Ok();
+  return hal::Status(hal::ErrorCode::kIoError,
+                     "control socket " + path + ": it was created with group id " + std::to_string(info.st_gid) +
+                         ", [control] group is '" + group + "' and giving it that group failed: chown: " +
+                         std::strerror(errno) +
+                         "; under systemd make it the daemon's group (a drop-in with Group=" + group +
+                         "), see cdpr-calibd.service");
+}
+
 }  // namespace
 
 ControlServer::Client::Client(int client_fd, unsigned long long round)
@@ -91,11 +110,11 @@ hal::Result<std::unique_ptr<ControlServer>> ControlServer::listen(const std::str
                            std::to_string(sizeof(address.sun_path) - 1) + " bytes");
   }
   std::memcpy(address.sun_path, path.c_str(), path.size() + 1);
-  gid_t gid = static_cast<gid_t>(-1);  // -1: keep the daemon's group
+  std::optional<gid_t> wanted_gid;  // none: the daemon's group, which bind() gives the socket
   if (!group.empty()) {
     const hal::Result<gid_t> resolved = group_id(path, group);
     if (!resolved.ok()) return resolved.status();
-    gid = resolved.value();
+    wanted_gid = resolved.value();
   }
   if (hal::Status removed = remove_stale_socket(path, address); !removed.ok()) return removed;
 
@@ -107,20 +126,14 @@ hal::Result<std::unique_ptr<ControlServer>> ControlServer::listen(const std::str
     return status;
   }
   // Clients are the robot's operators (group of the socket); nobody else.
-  // The group is set before the mode opens the socket to it. The backlog
+  // The group is right before the mode opens the socket to it. The backlog
   // holds a burst of simultaneous connects until the next service().
-  const char* failed = nullptr;
-  if (chown(path.c_str(), static_cast<uid_t>(-1), gid) != 0) {
-    failed = "chown (is the daemon's user a member of the group?)";
-  } else if (chmod(path.c_str(), static_cast<mode_t>(mode)) != 0) {
-    failed = "chmod";
-  } else if (::listen(fd, static_cast<int>(kMaxClients)) != 0) {
-    failed = "listen";
-  }
+  hal::Status status = wanted_gid ? give_socket_to_group(path, *wanted_gid, group) : hal::Status::Ok();
+  if (status.ok() && chmod(path.c_str(), static_cast<mode_t>(mode)) != 0) status = errno_status(path, "chmod");
+  if (status.ok() && ::listen(fd, static_cast<int>(kMaxClients)) != 0) status = errno_status(path, "listen");
   struct stat bound {};
-  if (failed == nullptr && lstat(path.c_str(), &bound) != 0) failed = "lstat";
-  if (failed != nullptr) {
-    hal::Status status = errno_status(path, failed);
+  if (status.ok() && lstat(path.c_str(), &bound) != 0) status = errno_status(path, "lstat");
+  if (!status.ok()) {
     close(fd);
     unlink(path.c_str());
     return status;

@@ -22,10 +22,12 @@
 // in the kernel for the next call; the first client served rotates), so the
 // loop's time per call stays bounded however hard clients push.
 //
-// Access: the socket gets `mode` (0660: owner and group) and, when `group` is
-// given, that group (the daemon's user must be a member: SupplementaryGroups=
-// in the unit; no capability is needed for that chown). Without a group it
-// keeps the daemon's own group.
+// Access: the socket gets `mode` (0660: owner and group) and the group it is
+// created with: the daemon's primary group (or a setgid directory's). A
+// `group` given is checked against it and, only when it differs, set with
+// chown(), which the shipped unit forbids (its seccomp filter, and
+// PrivateUsers= maps no other group): under systemd the group comes from
+// the unit's Group= instead (cdpr-calibd.service).
 //
 // Ownership: owns its listening and client sockets; the destructor closes
 // them and removes the socket file it bound, and only that file (same device
@@ -61,10 +63,11 @@ class ControlServer {
   // Binds and listens at `path` (a stale socket left by a crash, one nobody
   // listens on, is removed; a live one or any other file there is refused
   // and left alone), sets its mode to `mode` and, when `group` (a name or a
-  // numeric id) is not empty, its group.
+  // numeric id) is not empty and not already the socket's group, its group.
   // Errors: kInvalidArgument (path too long, not a socket in the way, no
   // such group), kInvalidState (another process listens there), kIoError
-  // (socket, bind, listen, chmod, chown), each naming the path and errno.
+  // (socket, bind, stat, chown, chmod, listen, lstat), each naming the path
+  // and errno.
   static hal::Result<std::unique_ptr<ControlServer>> listen(const std::string& path, Handler handler,
                                                            unsigned mode = 0660, const std::string& group = "");
   ~ControlServer();

@@ -138,6 +138,22 @@ inline std::optional<PlannedAcceptanceRobot> plan_acceptance_robot(calibration::
   return PlannedAcceptanceRobot{std::move(*data), start_world, std::move(plan)};
 }
 
+// One request through a fresh client of the daemon at `socket`, parsed; a
+// failed request is a test failure. The wait is generous (calibctl's default
+// is 10 s): at a load average near 10 the daemon's loop thread was once
+// starved past 10 s, and the daemon's responsiveness under load is
+// control_socket_test's job.
+inline calibctl::JsonValue ask_daemon(const std::string& socket, const std::string& request) {
+  constexpr int kResponseTimeoutMs = 60'000;
+  calibctl::ControlClient client;
+  std::string error, response;
+  EXPECT_TRUE(client.connect(socket, error)) << error;
+  EXPECT_TRUE(client.request(request, response, error, kResponseTimeoutMs)) << error;
+  auto value = calibctl::JsonValue::parse(response);
+  EXPECT_TRUE(value.has_value()) << response;
+  return value ? *value : calibctl::JsonValue{};
+}
+
 class VirtualRobotRig {
  public:
   // `before_start` runs once the robot is up, the configuration made and the
@@ -189,20 +205,7 @@ class VirtualRobotRig {
     loop_thread.join();
   }
 
-  // One request through a fresh client, parsed; a failed request is a test
-  // failure. The wait is generous (calibctl's default is 10 s): at a load
-  // average near 10 the daemon's loop thread was once starved past 10 s, and
-  // the daemon's responsiveness under load is control_socket_test's job.
-  calibctl::JsonValue ask(const std::string& request) {
-    constexpr int kResponseTimeoutMs = 60'000;
-    calibctl::ControlClient client;
-    std::string error, response;
-    EXPECT_TRUE(client.connect(config.control_socket, error)) << error;
-    EXPECT_TRUE(client.request(request, response, error, kResponseTimeoutMs)) << error;
-    auto value = calibctl::JsonValue::parse(response);
-    EXPECT_TRUE(value.has_value()) << response;
-    return value ? *value : calibctl::JsonValue{};
-  }
+  calibctl::JsonValue ask(const std::string& request) { return ask_daemon(config.control_socket, request); }
 
   std::string dir;
   bool keep_dir = false;

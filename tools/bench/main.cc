@@ -20,6 +20,7 @@
 #include "bench_problems.h"
 #include "solvers.h"
 #include "summary.h"
+#include "version/version.h"
 
 namespace {
 
@@ -71,6 +72,10 @@ bool has_flag(const std::vector<char*>& args, const char* prefix) {
 
 int main(int argc, char** argv) {
   std::vector<char*> args(argv, argv + argc);
+  if (has_flag(args, "--version")) {
+    std::printf("%s\n", cdpr::version::version_text("cdpr-bench").c_str());
+    return 0;
+  }
   std::string peak_solver;
   int peak_poses = 1000;
   for (auto it = args.begin() + 1; it != args.end();) {

@@ -17,6 +17,7 @@
 #include "calibctl/json_value.h"
 #include "calibctl/render.h"
 #include "src/control/control_response.h"
+#include "version/version.h"
 
 namespace {
 
@@ -96,6 +97,7 @@ int follow(ControlClient& client, const Options& options) {
 
 int main(int argc, char** argv) {
   CLI::App app{"calibctl: control the cable-robot self-calibration daemon (cdpr-calibd) through its control socket"};
+  app.set_version_flag("--version", cdpr::version::version_text("calibctl"));
   Options options;
   if (const char* env = std::getenv("CDPR_CALIB_SOCKET")) options.socket_path = env;
   app.add_option("--socket", options.socket_path, "the daemon's control socket (env CDPR_CALIB_SOCKET)")

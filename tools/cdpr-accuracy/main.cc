@@ -6,6 +6,7 @@
 
 #include "cdpr-accuracy/accuracy.h"
 #include "cdpr-accuracy/model_check.h"
+#include "version/version.h"
 
 namespace {
 
@@ -17,6 +18,7 @@ void print_row(const char* what, const cdpr::accuracy::Distribution& d) {
 
 int main(int argc, char** argv) {
   CLI::App app{"cdpr-accuracy: calibration accuracy over many seeds of simulated data"};
+  app.set_version_flag("--version", cdpr::version::version_text("cdpr-accuracy"));
   std::string preset_name = "large", model = "catenary";
   int poses = 35, seeds = 50, first_seed = 1;
   double perturbation = -1.0;

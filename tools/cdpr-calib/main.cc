@@ -3,9 +3,11 @@
 
 #include "diagnose_command.h"
 #include "solve_command.h"
+#include "version/version.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"cdpr-calib: offline self-calibration of cable-driven parallel robots with sagging cables"};
+  app.set_version_flag("--version", cdpr::version::version_text("cdpr-calib"));
   app.require_subcommand(1);
   cdpr::tools::SolveArgs solve_args;
   cdpr::tools::add_solve_command(app, solve_args);

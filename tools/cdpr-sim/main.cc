@@ -13,6 +13,7 @@
 #include "src/formats/calibration_toml.h"
 #include "src/formats/robot_toml.h"
 #include "src/formats/samples_csv.h"
+#include "version/version.h"
 
 namespace {
 
@@ -62,6 +63,7 @@ int main(int argc, char** argv) {
   CLI::App app{"cdpr-sim: simulated self-calibration data from the true static equilibrium of a cable robot "
                "with heavy (optionally elastic) cables; writes robot.toml (nominal), samples.csv (sensor "
                "readings) and truth.toml (true anchors, offsets and hidden effects)"};
+  app.set_version_flag("--version", cdpr::version::version_text("cdpr-sim"));
   Args args;
   DatasetConfig config;
   app.add_option("--preset", args.preset, "robot of the paper's Table I: large (240x220x50 m) or small (12.5x4.5x28.5 m)")

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "virtual-robot/virtual_robot.h"
+#include "version/version.h"
 
 namespace {
 
@@ -22,6 +23,7 @@ int main(int argc, char** argv) {
   CLI::App app{"virtual-robot: a simulated cable robot (true heavy-cable equilibrium, first-order settling, "
                "sensor noise of the preset) serving CANopen over a Unix socket, a Modbus TCP or RTU load cell and a "
                "pose stream; writes robot.toml (nominal), truth.toml and 'ready' into --endpoints"};
+  app.set_version_flag("--version", cdpr::version::version_text("virtual-robot"));
   VirtualRobotOptions options;
   std::string preset = "large";
   app.add_option("--preset", preset, "robot of the paper's Table I: large or small")
