@@ -103,13 +103,14 @@ void VirtualRobot::run(const std::atomic<bool>& stop) {
 
 void VirtualRobot::run_once(hal::TimeUs max_wait_us) {
   follow_pose_fault();
+  follow_can_fault();
   fds_.clear();
-  can_->append_poll_fds(fds_);
+  if (can_) can_->append_poll_fds(fds_);
   if (pose_) pose_->append_poll_fds(fds_);
   modbus_->append_poll_fds(fds_);
   const int ready = poll(fds_.data(), fds_.size(), static_cast<int>(max_wait_us / 1000));
   if (ready > 0) {
-    can_->service(fds_, [this](int client, std::string_view bytes) { on_can_bytes(client, bytes); });
+    if (can_) can_->service(fds_, [this](int client, std::string_view bytes) { on_can_bytes(client, bytes); });
     if (pose_) pose_->service(fds_, [](int, std::string_view) {});  // the pose stream is one-way
   }
   const hal::TimeUs now_us = clock_.now_us();
@@ -124,6 +125,7 @@ void VirtualRobot::run_once(hal::TimeUs max_wait_us) {
 
 void VirtualRobot::on_can_bytes(int client, std::string_view bytes) {
   std::string& partial = can_partial_[client];
+  if (can_fault_.load() != DeviceFault::kNone) return;  // the master's frames never reach the nodes
   partial.append(bytes);
   std::size_t used = 0;
   for (; partial.size() - used >= drivers::can::kWireFrameBytes; used += drivers::can::kWireFrameBytes) {
@@ -140,11 +142,16 @@ void VirtualRobot::publish(hal::TimeUs now_us) {
   nodes_->poll(now_us, frames_);
   std::uint8_t wire[drivers::can::kWireFrameBytes];
   std::string bytes;
-  for (const drivers::can::CanFrame& frame : frames_) {
+  const DeviceFault can_fault = can_fault_.load();
+  for (drivers::can::CanFrame frame : frames_) {
+    if (can_fault == DeviceFault::kSilent || can_fault == DeviceFault::kDisconnected) break;
+    if (can_fault == DeviceFault::kGarbage) {
+      for (std::uint8_t& byte : frame.data) byte ^= 0x5A;
+    }
     drivers::can::encode_wire_frame(frame, wire);
     bytes.append(reinterpret_cast<const char*>(wire), sizeof(wire));
   }
-  if (!bytes.empty()) can_->broadcast(bytes);
+  if (!bytes.empty() && can_) can_->broadcast(bytes);
 
   const Robot& robot = data_.true_robot.robot;
   const double k = options_.noise_scale;
@@ -163,6 +170,18 @@ void VirtualRobot::follow_pose_fault() {
   if (!disconnected && !pose_) {
     auto pose = StreamListener::listen(options_.dir + "/pose.sock");
     if (pose.ok()) pose_ = std::move(pose.value());
+  }
+}
+
+void VirtualRobot::follow_can_fault() {
+  const bool disconnected = can_fault_.load() == DeviceFault::kDisconnected;
+  if (disconnected && can_) {
+    can_.reset();  // closes every client, removes the socket
+    can_partial_.clear();
+  }
+  if (!disconnected && !can_) {
+    auto can = StreamListener::listen(options_.dir + "/can.sock");
+    if (can.ok()) can_ = std::move(can.value());
   }
 }
 

@@ -92,6 +92,12 @@ class VirtualRobot {
   // The pose stream's fault (any thread): kSilent stops sending, kGarbage
   // sends lines that are not poses, kDisconnected closes the socket.
   void set_pose_fault(DeviceFault fault) { pose_fault_.store(fault); }
+  // The CAN bus's fault (any thread), both directions at once as a cut or
+  // shorted bus: kSilent carries no frame either way, kDisconnected closes
+  // the CAN socket, kGarbage delivers every node's frame with its data
+  // bytes corrupted and nothing of the master's. The drives then see no
+  // master heartbeat and react per their 0x6007.
+  void set_can_fault(DeviceFault fault) { can_fault_.store(fault); }
 
  private:
   VirtualRobot(const VirtualRobotOptions& options, sim::SimulatedDataset data);
@@ -100,6 +106,8 @@ class VirtualRobot {
   void publish_pose(hal::TimeUs now_us);
   // Closes or reopens the pose socket as pose_fault_ says.
   void follow_pose_fault();
+  // Closes or reopens the CAN socket as can_fault_ says.
+  void follow_can_fault();
 
   VirtualRobotOptions options_;
   sim::SimulatedDataset data_;
@@ -112,6 +120,7 @@ class VirtualRobot {
   std::unique_ptr<VirtualLoadCell> cell_;
   std::unique_ptr<ModbusTransport> modbus_;
   std::atomic<DeviceFault> pose_fault_{DeviceFault::kNone};
+  std::atomic<DeviceFault> can_fault_{DeviceFault::kNone};
   std::array<std::atomic<double>, kCableCount> payout_snapshot_m_{};
   std::map<int, std::string> can_partial_;  // per CAN client: bytes of an incomplete record
   hal::TimeUs last_us_ = 0;
