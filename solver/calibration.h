@@ -53,7 +53,8 @@ struct Calibration {
   std::vector<WinchCalibration> winches;
   FitSummary fit;
   EffectValues effects;
-  // Readings refused as gross errors; their rows are not in `samples`.
+  // Readings refused as gross errors, left out of the final fit (with the
+  // rigid model their whole rows, which `samples` then does not count).
   std::vector<SensorReading> rejected;
   // Empty when the model fits the data; otherwise why not, in words with
   // the evidence (chi-square of the residuals against the noise, or an

@@ -108,7 +108,7 @@ std::string format_calibration_toml(const Calibration& calibration) {
   append_line(out, "created = " + calibration.created);
   append_line(out, "robot = " + toml_string(calibration.robot));
   append_line(out, "model = " + toml_strings(calibration.model), "the model terms that were fitted");
-  append_line(out, "samples = " + std::to_string(calibration.samples), "rows fitted (rejected rows not counted)");
+  append_line(out, "samples = " + std::to_string(calibration.samples), "rows fitted");
   if (!calibration.model_warning.empty()) {
     append_line(out, "model_warning = " + toml_string(calibration.model_warning),
                 "the model does not fit the data; sigmas scaled up by the misfit");
@@ -134,7 +134,7 @@ std::string format_calibration_toml(const Calibration& calibration) {
 
   append_effects(out, calibration.effects);
   append_sensor_readings(out, calibration.rejected, "rejected", "residual",
-                         "normalised residual [sigma] at the robust fit; the whole row was left out");
+                         "normalised residual [sigma] at the robust fit; left out of the final fit");
   return out;
 }
 
