@@ -74,6 +74,10 @@ struct CalibrationResult {
   // rows were left out of the final fit. Filled when ok and when refused for
   // too many of them.
   std::vector<SensorReading> gross_errors;
+  // Each reading left out of this fit (Sample::encoder_left_out,
+  // force_left_out) as the fit predicts it: its normalised residual, its
+  // row's pose and force fitted without it (a leave-one-out residual).
+  std::vector<SensorReading> left_out_residuals;
   // The model-fit test of the final fit (when ok): chi-square, its degrees
   // of freedom and upper-tail probability; true when it failed or the
   // problem is under-determined (calibration.model_warning says which).
