@@ -12,6 +12,7 @@
 #include "solver/calibration.h"
 #include "solver/effects.h"
 #include "solver/levenberg_marquardt.h"
+#include "solver/loss.h"
 #include "solver/problem.h"
 #include "solver/robot.h"
 #include "solver/sample.h"
@@ -22,7 +23,27 @@ enum class CableModelKind { kRigid, kCatenary };
 
 struct CalibrationOptions {
   CableModelKind cable_model = CableModelKind::kCatenary;
-  double huber_width = 0.0;  // robust loss width in sigma units; <= 0: none
+  // A Huber loss of this width [sigma] on the readings (and the pose prior)
+  // of the final fit; <= 0: least squares. Gross errors are the robust
+  // fit's business (below), not this.
+  double huber_width = 0.0;
+  // Robust fit (default): a Huber fit (convex, so it reaches the basin a
+  // least-squares fit would from the same start while a few gross errors
+  // pull only linearly), then, when a reading still stands out, a Cauchy fit
+  // from there (redescending: a gross error's pull fades, graduated
+  // non-convexity), then the test of solver/gross_errors.h on every reading;
+  // the rows of rejected readings are left out and the fit is redone by
+  // least squares. On clean data this ends at the least-squares minimum with
+  // its covariance. false: least squares (or huber_width) alone.
+  bool robust = true;
+  double rejection_threshold_sigma = 5.0;  // normalised residual of a gross error
+  // More rejected rows than this fraction and the calibration is refused:
+  // the robot or its sensors need attention (or the model does not fit).
+  double max_rejected_fraction = 0.4;
+  // The model-fit test: the final fit's chi-square against its degrees of
+  // freedom; a model that does not fit at this significance is reported in
+  // Calibration::model_warning and its sigmas are scaled up by the misfit.
+  double misfit_alpha = 1e-3;
   // Well-determined fits take 10-60; a few with sparse data (8 poses on the
   // small robot) crawl along a flat valley for 250-450 before converging,
   // and stopping them at 200 left them up to 0.3 m short even on noiseless data.
@@ -49,6 +70,21 @@ struct CalibrationResult {
   Calibration calibration;  // filled when ok (created/robot left to the caller)
   SolverSummary solver;
   std::vector<int> rejected_samples;  // sample ids refused before the solve, with reasons in message
+  // Gross errors found by the robust fit (also in calibration.rejected): its
+  // rows were left out of the final fit. Filled when ok and when refused for
+  // too many of them.
+  std::vector<SensorReading> gross_errors;
+  // Each reading left out of this fit (Sample::encoder_left_out,
+  // force_left_out) as the fit predicts it: its normalised residual, its
+  // row's pose and force fitted without it (a leave-one-out residual).
+  std::vector<SensorReading> left_out_residuals;
+  // The model-fit test of the final fit (when ok): chi-square, its degrees
+  // of freedom and upper-tail probability; true when it failed or the
+  // problem is under-determined (calibration.model_warning says which).
+  double chi_square = 0.0;
+  int degrees_of_freedom = 0;
+  double misfit_probability = 1.0;
+  bool misfit = false;
   std::vector<FittedEffect> effects;  // in CalibrationOptions::effects order, when ok
   // Covariance (tangent) of the global variables, in global_keys order:
   // AnchorKey(i), OffsetKey(i) per cable, then each effect's EffectKey.
@@ -60,6 +96,12 @@ struct CalibrationResult {
 // calibrate() and for benchmarks that must solve exactly the same problem.
 struct BuiltProblem {
   std::unique_ptr<Problem> problem;   // null when the inputs were refused (see message)
+  // The loss of every reading row (solver/loss.h's shared loss): set it
+  // between solves; least squares (or the Huber of huber_width) when built.
+  std::unique_ptr<LossFunction> reading_loss;
+  // Per pose k: the factor holding its readings (catenary), or the first of
+  // its kCableCount encoder factors (rigid), in problem->factors().
+  std::vector<int> reading_factor;
   std::vector<Sample> samples;        // the samples in the problem, pose k = samples[k]
   std::vector<int> rejected_samples;  // ids the model could not be started from
   std::string message;
@@ -67,6 +109,18 @@ struct BuiltProblem {
 BuiltProblem build_calibration_problem(const Robot& robot, const std::vector<Sample>& samples,
                                        const CalibrationOptions& options);
 
+// `samples` without the given gross errors: with the catenary model each
+// rejected reading is left out of its row (Sample::encoder_left_out,
+// force_left_out) and the rest of the row is kept; the rigid model has no
+// per-reading mask, so the whole row goes.
+std::vector<Sample> leave_out(const std::vector<Sample>& samples, const std::vector<SensorReading>& gross_errors,
+                              CableModelKind cable_model);
+
+// The robust fit (CalibrationOptions::robust), a restart with a looser
+// height consistency when the first fit stops where the anchors are
+// unobservable, the rows of gross errors left out and the fit redone, and
+// the model-fit test. Refuses (ok = false) when more than
+// max_rejected_fraction of the rows have gross errors.
 CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& samples,
                             const CalibrationOptions& options);
 

@@ -28,6 +28,18 @@ struct FitSummary {
   double rms_force_n = 0.0;
 };
 
+// One sensor reading of one samples.csv row: a reading a calibration
+// rejected as a gross error (residual in sigmas), or one a simulator made
+// wrong on purpose (error in the sensor's unit: m or N).
+enum class SensorKind { kEncoder, kForce };
+struct SensorReading {
+  int row = 0;        // sample id (samples.csv `id`)
+  SensorKind sensor = SensorKind::kEncoder;
+  int cable = 0;      // encoder: its cable; force: the reference cable
+  double value = 0.0; // rejected: normalised residual [sigma]; planted: error [m or N]
+};
+inline const char* sensor_name(SensorKind kind) { return kind == SensorKind::kEncoder ? "encoder" : "force"; }
+
 // Fitted parameters of extra model terms, by name (FORMATS.md [effects]);
 // scalars hold one value, per-cable terms one value per cable.
 using EffectValues = std::map<std::string, std::vector<double>>;
@@ -41,6 +53,13 @@ struct Calibration {
   std::vector<WinchCalibration> winches;
   FitSummary fit;
   EffectValues effects;
+  // Readings refused as gross errors, left out of the final fit (with the
+  // rigid model their whole rows, which `samples` then does not count).
+  std::vector<SensorReading> rejected;
+  // Empty when the model fits the data; otherwise why not, in words with
+  // the evidence (chi-square of the residuals against the noise, or an
+  // under-determined problem). Sigmas are already scaled up by the misfit.
+  std::string model_warning;
 };
 
 struct WinchTruth {
@@ -51,6 +70,10 @@ struct WinchTruth {
 struct Truth {
   std::vector<WinchTruth> winches;
   EffectValues effects;
+  // [effects] keys whose value is not a number or a list of numbers (e.g.
+  // `massless = true`): kept by name, never compared.
+  std::vector<std::string> uncompared_effects;
+  std::vector<SensorReading> outliers;  // readings the simulator made wrong on purpose
 };
 
 }  // namespace cdpr

@@ -233,7 +233,36 @@ void narrow_wide_effects(Diagnosis& d, const Robot& robot, const std::vector<Sam
 
 }  // namespace
 
-Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const DiagnosisOptions& options) {
+namespace {
+
+Diagnosis diagnose_rows(const Robot& robot, const std::vector<Sample>& samples, const DiagnosisOptions& options);
+
+}  // namespace
+
+Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& all_samples, const DiagnosisOptions& options) {
+  if (!options.fit.robust) return diagnose_rows(robot, all_samples, options);
+  const CalibrationResult robust = calibrate(robot, all_samples, options.fit);
+  const std::vector<Sample> samples = leave_out(all_samples, robust.gross_errors, options.fit.cable_model);
+  if (!robust.gross_errors.empty()) {
+    report(options, std::to_string(robust.gross_errors.size()) +
+                        " readings with gross errors left out (robust fit of the starting model)");
+  }
+  DiagnosisOptions plain = options;
+  plain.fit.robust = false;
+  // The workflow judges misfit itself (held-out chi-square against the fits'
+  // own uncertainty): sigmas scaled up by the model-fit test would widen
+  // that noise floor.
+  plain.fit.misfit_alpha = 0.0;
+  Diagnosis d = diagnose_rows(robot, samples, plain);
+  d.gross_errors = robust.gross_errors;
+  d.final_fit.calibration.rejected = robust.gross_errors;
+  d.final_fit.gross_errors = robust.gross_errors;
+  return d;
+}
+
+namespace {
+
+Diagnosis diagnose_rows(const Robot& robot, const std::vector<Sample>& samples, const DiagnosisOptions& options) {
   Diagnosis d;
   if (options.folds < 2 || static_cast<std::size_t>(options.folds) > samples.size()) {
     d.message = "need 2 to " + std::to_string(samples.size()) + " cross-validation folds, got " +
@@ -278,5 +307,7 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const
   d.ok = true;
   return d;
 }
+
+}  // namespace
 
 }  // namespace cdpr

@@ -99,8 +99,14 @@ struct Diagnosis {
   // step's normalized rms).
   double structure_p_value = 1.0;
   CalibrationResult final_fit;       // the final model on all samples (== steps.back().fit)
+  // Gross errors found by the robust fit of the starting model: left out of
+  // the whole workflow (a handful of gross errors is not an effect), and
+  // every fit after it is least squares on the same readings.
+  std::vector<SensorReading> gross_errors;
 };
 
+// With options.fit.robust (the default) the starting model is first fitted
+// robustly on all samples and its gross errors are left out (calibrate.h leave_out).
 Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& samples, const DiagnosisOptions& options);
 
 }  // namespace cdpr

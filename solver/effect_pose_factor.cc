@@ -5,6 +5,7 @@
 
 #include "solver/effect_cable.h"
 #include "solver/factor_support.h"
+#include "solver/pose_factor_rows.h"
 #include "solver/platform_statics.h"
 
 namespace cdpr {
@@ -38,6 +39,7 @@ EffectPoseFactor::EffectPoseFactor(const Robot& robot, int pose_index, const Sam
     : robot_(robot),
       encoder_m_(sample.encoder_m),
       force_n_(sample.force_n),
+      left_out_(left_out_rows(sample)),
       sigma_height_m_(sigma_height_m),
       loss_(loss) {
   keys_ = {PoseKey(pose_index), ReferenceForceKey(pose_index)};
@@ -71,7 +73,8 @@ double* EffectPoseFactor::effect_jacobian(double* const* jacobians, Effect e) co
 bool EffectPoseFactor::evaluate(const double* const* parameters, double* residual, double* const* jacobians,
                                 double* cost) const {
   if (!evaluate_model(parameters, residual, jacobians, nullptr)) return false;
-  *cost = apply_loss(loss_, kResidualDim, residual, jacobians, block_dims_);
+  zero_rows(std::span(left_out_.rows.data(), left_out_.count), residual, jacobians, block_dims_);
+  *cost = apply_loss_to_rows(loss_, kReadingRows, kResidualDim, residual, jacobians, block_dims_);
   return true;
 }
 

@@ -8,6 +8,7 @@
 // payout_i and z_i from solver/effect_cable.h (elasticity, density error,
 // swivel pulley), the statics with the weight at the nominal CoM + c.
 // With no effects it is the base catenary model (payout = arc length).
+// The Loss applies to the reading rows only (solver/pose_factor_rows.h).
 //
 // Variables, in keys() order: PoseKey(k), ReferenceForceKey(k),
 // AnchorKey(0..3), OffsetKey(0..3), then EffectKey(e) for each effect in the
@@ -19,6 +20,7 @@
 #include "solver/effects.h"
 #include "solver/factor.h"
 #include "solver/loss.h"
+#include "solver/pose_factor_rows.h"
 #include "solver/robot.h"
 #include "solver/sample.h"
 
@@ -64,6 +66,7 @@ class EffectPoseFactor final : public Factor {
   std::array<int, kEffectCount> effect_slot_;  // index into keys_, -1 when absent
   std::array<double, kCableCount> encoder_m_;
   double force_n_;
+  LeftOutRows left_out_;  // readings left out as gross errors (Sample::encoder_left_out, force_left_out)
   double sigma_height_m_;
   Loss loss_;
 };

@@ -18,4 +18,15 @@ Pose pose_from_parameters(const double* ambient);
 double apply_loss(const Loss& loss, int residual_dim, double* residual, double* const* jacobians,
                   std::span<const int> block_dims);
 
+// As apply_loss on the rows listed in `robust_rows` only; every other row
+// costs 0.5 r^2 and is left as it is (model identities such as the
+// attachment-height consistency of Eq. (15) are not readings and have no
+// gross errors).
+double apply_loss_to_rows(const Loss& loss, std::span<const int> robust_rows, int residual_dim, double* residual,
+                          double* const* jacobians, std::span<const int> block_dims);
+
+// Zeroes the listed rows of the residual and of every non-null Jacobian
+// block: readings left out of a fit.
+void zero_rows(std::span<const int> rows, double* residual, double* const* jacobians, std::span<const int> block_dims);
+
 }  // namespace cdpr

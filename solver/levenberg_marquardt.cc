@@ -330,6 +330,8 @@ LevenbergMarquardt::LevenbergMarquardt(Problem& problem, SolverOptions options)
 
 LevenbergMarquardt::~LevenbergMarquardt() = default;
 
+void LevenbergMarquardt::set_max_iterations(int max_iterations) { impl_->options.max_iterations = max_iterations; }
+
 SolverSummary LevenbergMarquardt::solve() { return impl_->solve(); }
 
 LinearSystemKind LevenbergMarquardt::linear_system() const { return impl_->system->kind(); }

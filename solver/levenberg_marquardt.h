@@ -91,6 +91,9 @@ class LevenbergMarquardt {
   ~LevenbergMarquardt();
 
   SolverSummary solve();
+  // The iteration limit of the next solve() calls (calibrate() shares one
+  // budget among the stages of its robust fit).
+  void set_max_iterations(int max_iterations);
 
   // Which linear system the constructor chose for this problem.
   LinearSystemKind linear_system() const;

@@ -16,6 +16,10 @@ struct Sample {
   Eigen::Quaterniond world_R_platform = Eigen::Quaterniond::Identity();    // unit, platform -> world
   std::array<double, kCableCount> encoder_m{};                             // [m] relative readings
   double force_n = 0.0;  // [N] load-cell tension of the reference cable at its attachment
+  // Readings a calibration left out as gross errors (solver/calibrate.h):
+  // the model fits the rest of the row without them. Not in samples.csv.
+  std::array<bool, kCableCount> encoder_left_out{};
+  bool force_left_out = false;
 };
 
 }  // namespace cdpr

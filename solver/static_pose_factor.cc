@@ -4,6 +4,7 @@
 
 #include "solver/catenary.h"
 #include "solver/factor_support.h"
+#include "solver/pose_factor_rows.h"
 #include "solver/platform_statics.h"
 
 namespace cdpr {
@@ -81,6 +82,7 @@ StaticPoseFactor::StaticPoseFactor(const Robot& robot, int pose_index, const Sam
     : robot_(robot),
       encoder_m_(sample.encoder_m),
       force_n_(sample.force_n),
+      left_out_(left_out_rows(sample)),
       sigma_height_m_(sigma_height_m),
       loss_(loss) {
   keys_[0] = PoseKey(pose_index);
@@ -135,7 +137,8 @@ bool StaticPoseFactor::evaluate(const double* const* parameters, double* residua
         tension > 0.0 ? Eigen::Vector2d(in.reference_force / (tension * sigma_force)) : Eigen::Vector2d::Zero();
     write_force_row(d_force, force_row, jacobians);
   }
-  *cost = apply_loss(loss_, kResidualDim, residual, jacobians, kBlockDims);
+  zero_rows(std::span(left_out_.rows.data(), left_out_.count), residual, jacobians, kBlockDims);
+  *cost = apply_loss_to_rows(loss_, kReadingRows, kResidualDim, residual, jacobians, kBlockDims);
   return true;
 }
 

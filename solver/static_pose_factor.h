@@ -4,7 +4,8 @@
 // residuals of all four cables, which the statics of Eq. (11) couple.
 //
 // Variables: PoseKey(k), ReferenceForceKey(k), AnchorKey(0..3), OffsetKey(0..3).
-// Residuals (whitened by their sigma, then robustified by the Loss):
+// Residuals (whitened by their sigma; the Loss robustifies the readings,
+// encoder and force rows, not the height identity, solver/pose_factor_rows.h):
 //   [0..3] encoder i:   (l_C,i + l0_i - z_enc,i) / sigma_encoder
 //   [4..7] height i:    (b_z,i - z_i(L_i)) / sigma_height
 //   [8]    force:       (|(f_h, f_v)_ref| - z_force) / sigma_force
@@ -13,6 +14,7 @@
 
 #include "solver/factor.h"
 #include "solver/loss.h"
+#include "solver/pose_factor_rows.h"
 #include "solver/robot.h"
 #include "solver/sample.h"
 
@@ -42,6 +44,7 @@ class StaticPoseFactor final : public Factor {
   std::array<Key, kKeyCount> keys_;
   std::array<double, kCableCount> encoder_m_;
   double force_n_;
+  LeftOutRows left_out_;  // readings left out as gross errors (Sample::encoder_left_out, force_left_out)
   double sigma_height_m_;
   Loss loss_;
 };

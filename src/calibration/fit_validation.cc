@@ -85,6 +85,7 @@ ValidationResult validate_fit(const CalibrationResult& result, const Robot& robo
                       std::to_string(limits.min_samples) + " needed)");
   }
   check_residuals(calibration.fit, robot.noise, limits, reasons);
+  if (!calibration.model_warning.empty()) reasons.push_back(calibration.model_warning);
   for (int i = 0; i < robot.cable_count(); ++i) check_winch(i, calibration.winches[i], previous, limits, reasons);
   return validation;
 }

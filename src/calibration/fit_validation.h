@@ -9,6 +9,7 @@
 //  - one result per cable, every value finite, enough samples;
 //  - residuals consistent with the sensor noise of robot.toml [noise]:
 //    rms_encoder <= max_rms_encoder_sigmas * noise.encoder, same for force;
+//  - the model fits (calibrate()'s model-fit test: no model_warning);
 //  - uncertainty small: every anchor_sigma axis and offset_sigma below limits;
 //  - plausible change from the previous calibration: each anchor moved at
 //    most max_anchor_change_m (a pulley does not wander metres between

@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include "src/formats/effects_toml.h"
+#include "src/formats/sensor_readings_toml.h"
 #include "src/formats/toml_reader.h"
 #include "src/formats/toml_writer.h"
 
@@ -68,15 +69,19 @@ Calibration read_calibration(TomlReader& reader, const toml::table& root) {
                      {"samples", kRequired},
                      {"winch", kRequired},
                      {"fit", kRequired},
-                     {"effects", kOptional}});
+                     {"effects", kOptional},
+                     {"model_warning", kOptional},
+                     {"rejected", kOptional}});
   calibration.format = static_cast<int>(format);
   calibration.created = reader.offset_date_time(root, "created", "");
   calibration.robot = reader.string(root, "robot", "");
   calibration.model = reader.strings(root, "model", "");
   calibration.samples = reader.count(root, "samples", "");
+  if (root.contains("model_warning")) calibration.model_warning = reader.string(root, "model_warning", "");
   calibration.winches = read_winches(reader, root);
   calibration.fit = read_fit(reader, root);
   calibration.effects = read_effects(reader, root);
+  calibration.rejected = read_sensor_readings(reader, root, "rejected", "residual");
   return calibration;
 }
 
@@ -103,7 +108,11 @@ std::string format_calibration_toml(const Calibration& calibration) {
   append_line(out, "created = " + calibration.created);
   append_line(out, "robot = " + toml_string(calibration.robot));
   append_line(out, "model = " + toml_strings(calibration.model), "the model terms that were fitted");
-  append_line(out, "samples = " + std::to_string(calibration.samples));
+  append_line(out, "samples = " + std::to_string(calibration.samples), "rows fitted");
+  if (!calibration.model_warning.empty()) {
+    append_line(out, "model_warning = " + toml_string(calibration.model_warning),
+                "the model does not fit the data; sigmas scaled up by the misfit");
+  }
 
   for (std::size_t i = 0; i < calibration.winches.size(); ++i) {
     const WinchCalibration& winch = calibration.winches[i];
@@ -124,6 +133,8 @@ std::string format_calibration_toml(const Calibration& calibration) {
   append_line(out, "rms_force = " + toml_number(fit.rms_force_n), "N");
 
   append_effects(out, calibration.effects);
+  append_sensor_readings(out, calibration.rejected, "rejected", "residual",
+                         "normalised residual [sigma] at the robust fit; left out of the final fit");
   return out;
 }
 

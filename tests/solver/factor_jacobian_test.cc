@@ -31,7 +31,10 @@ void check_static_pose_factor(const Robot& robot, const Eigen::Vector3d& positio
   ASSERT_TRUE(force.has_value());
   const StaticPoseFactor factor(robot, 0, sample, 1e-3, Loss{huber});
   if (huber > 0.0) {
-    test::expect_gradient_matches_cost(factor, static_pose_variables(robot, pose, *force), 1e-6, 1e-5);
+    // The loss robustifies the readings only: the height rows of Eq. (15),
+    // hundreds of sigmas off at this untuned point, keep their squares, so
+    // the cost is ~1e8 and its central differences carry ~1e-2 of rounding.
+    test::expect_gradient_matches_cost(factor, static_pose_variables(robot, pose, *force), 1e-6, 2e-4);
   } else {
     test::expect_jacobians_match(factor, static_pose_variables(robot, pose, *force), 1e-6, 1e-5);
   }

@@ -100,7 +100,7 @@ namespace {
 // first undamped step leaves its domain, so the loop also runs through
 // refused and rejected candidates. Linked poses make the solver factorise
 // the whole J^T J; without the links it eliminates the poses first.
-Problem realistic_problem(int* refusals, bool link_poses) {
+Problem realistic_problem(int* refusals, bool link_poses, Loss loss) {
   const std::array<Eigen::Vector3d, 4> anchors = {
       Eigen::Vector3d(0, 0, 20), Eigen::Vector3d(30, 0, 21), Eigen::Vector3d(30, 25, 19), Eigen::Vector3d(0, 25, 20)};
   const std::array<Eigen::Vector3d, 4> attachments = {
@@ -128,7 +128,7 @@ Problem realistic_problem(int* refusals, bool link_poses) {
       double encoder = (truth[k].transform(attachments[i]) - anchors[i]).norm() + 0.1 * i;
       if ((k * 4 + i) % 37 == 0) encoder += 0.5;  // outlier
       problem.add_factor(std::make_unique<test::RangeFactor>(PoseKey(k), AnchorKey(i), OffsetKey(i), attachments[i],
-                                                             encoder, 0.002, Loss{3.0}));
+                                                             encoder, 0.002, loss));
     }
     if (link_poses && k > 0) {
       Pose a_T_b;
@@ -145,10 +145,10 @@ Problem realistic_problem(int* refusals, bool link_poses) {
 
 // Solves with the allocation counter on; the count between the first and
 // the last progress call is what the loop allocated.
-void expect_loop_allocates_nothing(bool link_poses, LinearSystemKind expected_system) {
+void expect_loop_allocates_nothing(bool link_poses, LinearSystemKind expected_system, Loss loss = Loss{3.0}) {
   // GIVEN a realistic problem and a solver built for it (setup may allocate)
   int refusals = 0;
-  Problem problem = realistic_problem(&refusals, link_poses);
+  Problem problem = realistic_problem(&refusals, link_poses, loss);
   long first = -1, last = -1;
   int calls = 0, rejected = 0;
   SolverOptions options;
@@ -190,6 +190,14 @@ TEST(LevenbergMarquardtAllocation, IterationLoopAllocatesNothing) {
 TEST(LevenbergMarquardtAllocation, IterationLoopWithPosesEliminatedAllocatesNothing) {
   if (!CDPR_COUNT_ALLOCATIONS) GTEST_SKIP() << "allocation counting is off under AddressSanitizer";
   expect_loop_allocates_nothing(false, LinearSystemKind::kPosesEliminated);
+}
+
+TEST(LevenbergMarquardtAllocation, IterationLoopWithASharedCauchyLossAllocatesNothing) {
+  // The loss calibrate()'s robust stages switch between solves, read by the
+  // factors at every evaluation.
+  if (!CDPR_COUNT_ALLOCATIONS) GTEST_SKIP() << "allocation counting is off under AddressSanitizer";
+  const LossFunction cauchy{LossKind::kCauchy, 3.0};
+  expect_loop_allocates_nothing(false, LinearSystemKind::kPosesEliminated, Loss{0.0, &cauchy});
 }
 
 }  // namespace

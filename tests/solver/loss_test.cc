@@ -1,5 +1,6 @@
 #include "solver/loss.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -41,6 +42,32 @@ TEST(Loss, ScaledResidualCarriesTheHuberGradient) {
     EXPECT_NEAR(s * s * r, dcost, 1e-7) << r;
     EXPECT_LT(s, 1.0);
   }
+}
+
+TEST(Loss, CauchyRedescendsAndCarriesItsGradient) {
+  // GIVEN a Cauchy loss of width 3
+  const LossFunction cauchy{LossKind::kCauchy, 3.0};
+  for (double r : {-50.0, -2.0, 0.5, 3.0, 400.0}) {
+    // THEN the scaled residual carries d cost / dr (IRLS weight rho')
+    const double s = cauchy.scale(r);
+    const double h = 1e-6;
+    const double dcost = (cauchy.cost(r + h) - cauchy.cost(r - h)) / (2 * h);
+    EXPECT_NEAR(s * s * r, dcost, 1e-6 * std::max(1.0, std::abs(dcost))) << r;
+  }
+  // AND a gross error pulls less the larger it is (redescending influence)
+  EXPECT_LT(std::pow(cauchy.scale(400.0), 2) * 400.0, std::pow(cauchy.scale(40.0), 2) * 40.0);
+  EXPECT_NEAR(cauchy.cost(0.01), 0.5 * 0.01 * 0.01, 1e-9);
+}
+
+TEST(Loss, SharedLossFollowsItsFunction) {
+  // GIVEN a Loss reading a shared function
+  LossFunction function{LossKind::kHuber, 2.0};
+  const Loss loss{0.0, &function};
+  EXPECT_DOUBLE_EQ(loss.cost(10.0), 2.0 * 10.0 - 2.0);
+  // WHEN the function changes between solves THEN the Loss follows it
+  function = LossFunction{};
+  EXPECT_DOUBLE_EQ(loss.cost(10.0), 50.0);
+  EXPECT_DOUBLE_EQ(loss.scale(10.0), 1.0);
 }
 
 }  // namespace

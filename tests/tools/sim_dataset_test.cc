@@ -138,6 +138,35 @@ TEST(SimDataset, EncoderScaleMultipliesThePayout) {
   EXPECT_EQ(s.with.truth.effects.at("encoder_scale").size(), 4u);
 }
 
+TEST(SimDataset, GrossErrorsChangeOnlyThePlantedReadingsAndAreListed) {
+  // GIVEN the same data set with 10 % gross encoder errors and 10 % force spikes
+  DatasetConfig config = noiseless(Preset::kLarge, 20);
+  const SimulatedDataset clean = simulate(config);
+  config.gross_errors.encoder_fraction = 0.1;
+  config.gross_errors.force_fraction = 0.1;
+  const SimulatedDataset dirty = simulate(config);
+  // THEN truth lists 2 + 2 readings, each off by its listed error within the
+  // documented ranges, and every other reading is unchanged
+  ASSERT_EQ(dirty.truth.outliers.size(), 4u);
+  std::vector<std::array<double, kCableCount + 1>> expected(clean.samples.size());
+  for (const SensorReading& o : dirty.truth.outliers) {
+    const int slot = o.sensor == SensorKind::kForce ? kCableCount : o.cable;
+    expected[o.row][slot] = o.value;
+    const double size = std::abs(o.value);
+    if (o.sensor == SensorKind::kEncoder) {
+      EXPECT_TRUE(size >= 0.5 && size <= 2.0) << size;
+    } else {
+      EXPECT_TRUE(size >= 50.0 && size <= 500.0) << size;
+    }
+  }
+  for (std::size_t k = 0; k < clean.samples.size(); ++k) {
+    for (int i = 0; i < kCableCount; ++i) {
+      EXPECT_NEAR(dirty.samples[k].encoder_m[i] - clean.samples[k].encoder_m[i], expected[k][i], 1e-9);
+    }
+    EXPECT_NEAR(dirty.samples[k].force_n - clean.samples[k].force_n, expected[k][kCableCount], 1e-9);
+  }
+}
+
 TEST(SimDataset, LoadCellBiasAndGainActOnTheTension) {
   // GIVEN a load-cell bias and gain; THEN force = (1 + g) T + b, encoders unchanged
   const Shift s = shift_of([](HiddenEffects& e) {

@@ -59,6 +59,23 @@ void BM_EndToEnd(benchmark::State& state) {
   state.SetLabel(series_name(solver));
 }
 
+// calibrate() with default options: the robust fit's stages (Huber, and on
+// clean data nothing more but the least-squares check), the covariance and
+// the model-fit test included; compare with BM_EndToEnd of the Ceres
+// configurations (which build and solve the least-squares problem alone).
+void BM_Calibrate(benchmark::State& state) {
+  const int poses = static_cast<int>(state.range(0));
+  const BenchData& data = bench_data(poses);
+  RunRecord run;
+  for (auto _ : state) {
+    const double start = thread_seconds();
+    const CalibrationResult result = calibrate(data.robot, data.samples, CalibrationOptions{});
+    run = {thread_seconds() - start, result.solver.iterations, result.solver.final_cost};
+    record("calibrate", "e2e", poses, run);
+  }
+  report(state, run);
+}
+
 // Build problem only (build_calibration_problem: the data-driven start of
 // every pose), the part both solvers' end-to-end runs share.
 void BM_BuildProblem(benchmark::State& state) {
@@ -104,6 +121,7 @@ void pose_counts_and_solvers(benchmark::internal::Benchmark* b) {
 
 BENCHMARK(BM_BuildProblem)->ArgName("poses")->Arg(9)->Arg(35)->Arg(109)->Arg(1000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_EndToEnd)->Apply(pose_counts_and_solvers);
+BENCHMARK(BM_Calibrate)->ArgName("poses")->Arg(9)->Arg(35)->Arg(109)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Solve)->Apply(pose_counts_and_solvers);
 
 }  // namespace

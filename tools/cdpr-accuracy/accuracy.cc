@@ -8,6 +8,39 @@
 
 namespace cdpr::accuracy {
 
+namespace {
+
+void score_gross_errors(const std::vector<SensorReading>& planted, const std::vector<SensorReading>& rejected, int rows,
+                        RunResult& run) {
+  constexpr double kRecallFloorM = 0.3;  // encoder errors this large must all be found
+  auto found = [&](const SensorReading& p) {
+    return std::any_of(rejected.begin(), rejected.end(), [&](const SensorReading& r) {
+      return r.row == p.row && r.sensor == p.sensor && (p.sensor == SensorKind::kForce || r.cable == p.cable);
+    });
+  };
+  std::vector<bool> planted_row(rows, false), rejected_row(rows, false);
+  for (const SensorReading& p : planted) {
+    if (p.row >= 0 && p.row < rows) planted_row[p.row] = true;
+    if (p.sensor == SensorKind::kEncoder && std::abs(p.value) >= kRecallFloorM) {
+      ++run.planted_encoder;
+      run.recalled_encoder += found(p);
+    } else if (p.sensor == SensorKind::kForce) {
+      ++run.planted_force;
+      run.recalled_force += found(p);
+    }
+  }
+  for (const SensorReading& r : rejected) {
+    if (r.row >= 0 && r.row < rows) rejected_row[r.row] = true;
+  }
+  for (int k = 0; k < rows; ++k) {
+    if (planted_row[k]) continue;
+    ++run.clean_rows;
+    run.clean_rows_rejected += rejected_row[k];
+  }
+}
+
+}  // namespace
+
 RunResult run_case(const Case& c, std::uint64_t seed) {
   RunResult run;
   run.seed = seed;
@@ -20,6 +53,8 @@ RunResult run_case(const Case& c, std::uint64_t seed) {
   config.workspace_min = c.workspace_min;
   config.workspace_max = c.workspace_max;
   config.design_candidates = c.design_candidates;
+  config.gross_errors = c.gross_errors;
+  config.effects = c.effects;
   const auto data = sim::simulate_dataset(config);
   if (!data) {
     run.message = "simulation failed: " + data.error();
@@ -32,6 +67,23 @@ RunResult run_case(const Case& c, std::uint64_t seed) {
   run.ok = result.ok;
   run.message = result.message;
   run.iterations = result.solver.iterations;
+  run.misfit = result.misfit;
+  run.refused = !result.ok && !result.gross_errors.empty();
+  run.chi_square_ratio = result.degrees_of_freedom > 0 ? result.chi_square / result.degrees_of_freedom : 0.0;
+  run.cost_final = result.solver.final_cost;
+  score_gross_errors(data->truth.outliers, result.gross_errors, static_cast<int>(data->samples.size()), run);
+  if (c.compare_truth_start) {
+    Robot at_truth = data->nominal;
+    for (std::size_t i = 0; i < at_truth.winches.size(); ++i) {
+      at_truth.winches[i].anchor_world = data->truth.winches[i].anchor_world;
+    }
+    const CalibrationResult reference = calibrate(at_truth, data->samples, options);
+    run.truth_start_ok = result.ok && reference.ok;
+    if (run.truth_start_ok) {
+      run.truth_start_cost_gap = (result.solver.final_cost - reference.solver.final_cost) /
+                                 std::max(reference.solver.final_cost, 1e-300);
+    }
+  }
   const std::vector<WinchTruth>& truth = data->truth.winches;
   const int n = static_cast<int>(truth.size());
   std::vector<Pose> true_poses;
@@ -84,6 +136,16 @@ Summary summarise(const std::vector<RunResult>& runs) {
     sq += r.normalised_sq_sum;
     count += r.normalised_count;
     iterations += r.iterations;
+    s.planted_encoder += r.planted_encoder;
+    s.recalled_encoder += r.recalled_encoder;
+    s.planted_force += r.planted_force;
+    s.recalled_force += r.recalled_force;
+    s.clean_rows += r.clean_rows;
+    s.clean_rows_rejected += r.clean_rows_rejected;
+    s.misfits += r.misfit;
+    s.refusals += r.refused;
+    if (!r.truth_start_ok || std::abs(r.truth_start_cost_gap) > 1e-6) ++s.truth_start_mismatches;
+    s.worst_truth_start_gap = std::max(s.worst_truth_start_gap, std::abs(r.truth_start_cost_gap));
   }
   s.anchor = distribution(anchors);
   s.offset = distribution(offsets);

@@ -10,7 +10,9 @@
 
 #include <Eigen/Core>
 
+#include "sim/outliers.h"
 #include "sim/presets.h"
+#include "sim/true_robot.h"
 #include "solver/calibrate.h"
 
 namespace cdpr::accuracy {
@@ -24,6 +26,11 @@ struct Case {
   std::optional<Eigen::Vector3d> workspace_min, workspace_max;  // preset's when empty
   int design_candidates = 0;  // sim/dataset.h: 0 = even spread, N = most informative of N
   int max_iterations = CalibrationOptions{}.max_iterations;
+  sim::GrossErrors gross_errors;  // planted in the data (sim/outliers.h)
+  sim::HiddenEffects effects;     // hidden in the data (mis-modelled data for the model-fit test)
+  // Also fit from the true anchors and compare the final costs (the same
+  // minimum within 1e-6 relative, or not).
+  bool compare_truth_start = false;
 };
 
 struct RunResult {
@@ -39,6 +46,16 @@ struct RunResult {
   // sigma norm sqrt(sx^2 + sy^2 + sz^2) (the RMS of |a - a_true|):
   double reported_sigma_m = 0.0;  // from the fit's own covariance (0 when it failed)
   double straight_bound_m = 0.0;  // Cramer-Rao, straight cables, true robot and poses (solver/pose_design.h)
+  // Gross errors: planted (encoder >= 0.3 m, and force spikes), how many of
+  // them were rejected, and clean rows (no planted error) rejected.
+  int planted_encoder = 0, recalled_encoder = 0, planted_force = 0, recalled_force = 0;
+  int clean_rows = 0, clean_rows_rejected = 0;
+  bool misfit = false;               // the model-fit test flagged the fit
+  bool refused = false;              // refused for too many gross errors
+  double chi_square_ratio = 0.0;     // chi2 / dof of the final fit
+  double cost_final = 0.0;
+  bool truth_start_ok = true;        // compare_truth_start: it converged too
+  double truth_start_cost_gap = 0.0; // (cost - cost from truth) / cost from truth
 };
 
 RunResult run_case(const Case& c, std::uint64_t seed);
@@ -56,6 +73,12 @@ struct Summary {
   double mean_reported_sigma_m = 0.0;  // over the successful runs
   double mean_straight_bound_m = 0.0;
   double mean_iterations = 0.0;
+  int planted_encoder = 0, recalled_encoder = 0, planted_force = 0, recalled_force = 0;
+  int clean_rows = 0, clean_rows_rejected = 0;
+  int misfits = 0;
+  int refusals = 0;
+  int truth_start_mismatches = 0;  // |cost gap| > 1e-6 or one of the two fits failed
+  double worst_truth_start_gap = 0.0;
 };
 Summary summarise(const std::vector<RunResult>& runs);
 

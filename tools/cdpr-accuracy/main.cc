@@ -26,7 +26,10 @@ int main(int argc, char** argv) {
   int design_candidates = 0;
   double noise_scale = 1.0;
   int max_iterations = cdpr::CalibrationOptions{}.max_iterations;
-  bool model_check_only = false, verbose = false;
+  bool model_check_only = false, verbose = false, truth_start = false;
+  cdpr::sim::GrossErrors gross;
+  cdpr::sim::HiddenEffects effects;
+  std::vector<double> com_offset;
   app.add_option("--preset", preset_name, "large | small")->check(CLI::IsMember({"large", "small"}))->capture_default_str();
   app.add_option("--poses", poses, "static poses per data set")->capture_default_str();
   app.add_option("--seeds", seeds, "number of data sets (seeds first-seed ..)")->capture_default_str();
@@ -47,6 +50,18 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--max-iterations", max_iterations, "Levenberg-Marquardt iterations per fit, at most")
       ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--encoder-outliers", gross.encoder_fraction, "fraction of rows with a 0.5-2 m encoder error (cdpr-sim)")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  app.add_option("--force-spikes", gross.force_fraction, "fraction of rows with a 50-500 N load-cell spike (cdpr-sim)")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  app.add_option("--density-error", effects.density_error,
+                 "hidden cable density error of the data (-0.999: nearly weightless cables)")
+      ->check(CLI::Range(-0.9999, 10.0));
+  app.add_option("--com-offset", com_offset, "hidden centre-of-mass offset x,y,z [m] of the data")
+      ->delimiter(',')->expected(3);
+  app.add_flag("--truth-start", truth_start,
+               "also fit each data set from the true anchors and count fits whose final cost differs by more than "
+               "1e-6 relative (a different minimum) or that fail");
   app.add_flag("--model-check", model_check_only, "only run the Table I model check");
   app.add_flag("-v,--verbose", verbose, "one line per run");
   CLI11_PARSE(app, argc, argv);
@@ -77,6 +92,10 @@ int main(int argc, char** argv) {
   c.design_candidates = design_candidates;
   c.noise_scale = noise_scale;
   c.max_iterations = max_iterations;
+  c.gross_errors = gross;
+  if (com_offset.size() == 3) effects.com_offset_platform = Eigen::Vector3d(com_offset[0], com_offset[1], com_offset[2]);
+  c.effects = effects;
+  c.compare_truth_start = truth_start;
   std::vector<cdpr::CableModelKind> models;
   if (model != "rigid") models.push_back(cdpr::CableModelKind::kCatenary);
   if (model != "catenary") models.push_back(cdpr::CableModelKind::kRigid);
@@ -87,9 +106,12 @@ int main(int argc, char** argv) {
       runs.push_back(cdpr::accuracy::run_case(c, static_cast<std::uint64_t>(first_seed + s)));
       const auto& r = runs.back();
       if (verbose) {
-        std::printf("seed %3llu %s anchor %.4f m offset %.4f m iterations %d %s\n",
+        std::printf("seed %3llu %s anchor %.4f m offset %.4f m iterations %d rejected clean %d planted %d/%d%s "
+                    "chi2/dof %.3f truth-start gap %.1e %s\n",
                     static_cast<unsigned long long>(r.seed), r.ok ? "ok    " : "FAILED", r.anchor_error_m,
-                    r.offset_error_m, r.iterations, r.ok ? "" : r.message.c_str());
+                    r.offset_error_m, r.iterations, r.clean_rows_rejected, r.recalled_encoder + r.recalled_force,
+                    r.planted_encoder + r.planted_force, r.misfit ? " MISFIT" : "", r.chi_square_ratio, r.truth_start_cost_gap,
+                    r.ok ? "" : r.message.c_str());
       } else {
         std::fprintf(stderr, "\r%s model: run %d/%d", kind == cdpr::CableModelKind::kRigid ? "rigid" : "catenary",
                      s + 1, seeds);
@@ -106,6 +128,16 @@ int main(int argc, char** argv) {
     std::printf("  normalised error RMS (error/sigma): %.2f\n", s.normalised_rms);
     std::printf("  anchor sigma norm, mean [m]: reported by the fit %.4f, straight-cable Cramer-Rao bound %.4f\n",
                 s.mean_reported_sigma_m, s.mean_straight_bound_m);
+    std::printf("  gross errors rejected: encoder (>= 0.3 m) %d of %d, force %d of %d; clean rows rejected %d of %d "
+                "(%.2f %%)\n",
+                s.recalled_encoder, s.planted_encoder, s.recalled_force, s.planted_force, s.clean_rows_rejected,
+                s.clean_rows, s.clean_rows ? 100.0 * s.clean_rows_rejected / s.clean_rows : 0.0);
+    std::printf("  model-fit test flagged %d of %d runs; %d refused for too many gross errors\n", s.misfits, s.runs,
+                s.refusals);
+    if (truth_start) {
+      std::printf("  truth-started minimum: %d runs differ (> 1e-6 relative cost, or a failed fit); worst gap %.1e\n",
+                  s.truth_start_mismatches, s.worst_truth_start_gap);
+    }
   }
   return 0;
 }

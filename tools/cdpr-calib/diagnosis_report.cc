@@ -105,7 +105,7 @@ void append_summary(std::string& out, const Diagnosis& d, const ReportContext& c
     append(out, " anchor_error_final=%.4f effect_sigma_distance=%.2f", mean_anchor_error(d.final_fit.calibration, *c.truth),
            worst);
   }
-  append(out, "\n");
+  append(out, " gross_errors=%zu\n", d.gross_errors.size());
 }
 
 }  // namespace
@@ -193,6 +193,13 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
     }
   } else {
     append(out, "final fit on all samples failed: %s\n", d.final_fit.message.c_str());
+  }
+  if (!d.gross_errors.empty()) {
+    append(out, "rows left out as gross errors (robust fit of the starting model; not an effect):\n");
+    for (const SensorReading& r : d.gross_errors) {
+      append(out, "  row %d %s%s: %+.1f sigma\n", r.row, sensor_name(r.sensor),
+             r.sensor == SensorKind::kEncoder ? (" cable " + std::to_string(r.cable)).c_str() : "", r.value);
+    }
   }
   append_summary(out, d, c);
   return out;

@@ -1,5 +1,6 @@
 #include "report.h"
 
+#include <algorithm>
 #include <cmath>
 #include <ctime>
 
@@ -21,6 +22,7 @@ void print_summary(std::FILE* out, const CalibrationResult& result, const Robot&
     for (int id : result.rejected_samples) std::fprintf(out, " %d", id);
     std::fprintf(out, "\n");
   }
+  print_gross_errors(out, result.gross_errors);
   if (!result.ok) return;
   const Calibration& cal = result.calibration;
   std::string model;
@@ -36,6 +38,18 @@ void print_summary(std::FILE* out, const CalibrationResult& result, const Robot&
                  w.offset_m, w.offset_sigma_m);
   }
   print_effects(out, cal.effects);
+  if (!cal.model_warning.empty()) std::fprintf(out, "MODEL WARNING: %s\n", cal.model_warning.c_str());
+}
+
+void print_gross_errors(std::FILE* out, const std::vector<SensorReading>& rejected) {
+  if (rejected.empty()) return;
+  std::fprintf(out, "gross errors (normalised residual at the robust fit; left out of the final fit):\n");
+  for (const SensorReading& r : rejected) {
+    std::fprintf(out, "  row %4d  %-7s", r.row, sensor_name(r.sensor));
+    if (r.sensor == SensorKind::kEncoder) std::fprintf(out, " cable %d", r.cable);
+    else std::fprintf(out, "        ");
+    std::fprintf(out, "  %+8.1f sigma\n", r.value);
+  }
 }
 
 void print_effects(std::FILE* out, const EffectValues& effects) {
@@ -71,6 +85,26 @@ void print_truth_comparison(std::FILE* out, const Calibration& calibration, cons
     std::fprintf(out, "true effects:\n");
     print_effects(out, truth.effects);
   }
+  for (const std::string& name : truth.uncompared_effects) {
+    std::fprintf(out, "true effect %s: not compared (not a number or a list of numbers)\n", name.c_str());
+  }
+  print_outlier_recall(out, calibration.rejected, truth.outliers);
+}
+
+void print_outlier_recall(std::FILE* out, const std::vector<SensorReading>& rejected,
+                          const std::vector<SensorReading>& planted) {
+  if (planted.empty() && rejected.empty()) return;
+  int found = 0;
+  for (const SensorReading& p : planted) {
+    const bool hit = std::any_of(rejected.begin(), rejected.end(), [&](const SensorReading& r) {
+      return r.row == p.row && r.sensor == p.sensor && (r.sensor == SensorKind::kForce || r.cable == p.cable);
+    });
+    found += hit;
+    std::fprintf(out, "planted %-7s row %4d cable %d error %+.3g: %s\n", sensor_name(p.sensor), p.row, p.cable,
+                 p.value, hit ? "rejected" : "NOT rejected");
+  }
+  std::fprintf(out, "planted gross errors rejected: %d of %zu; rejected readings: %zu\n", found, planted.size(),
+               rejected.size());
 }
 
 std::string utc_timestamp_now() {

@@ -13,8 +13,14 @@ void print_iteration(std::FILE* out, const IterationSummary& it);
 void print_summary(std::FILE* out, const CalibrationResult& result, const Robot& robot);
 // Fitted (or true) [effects] values, each with its "<name>_sigma" if present.
 void print_effects(std::FILE* out, const EffectValues& effects);
-// Anchor and offset errors against a simulator's truth.toml.
+// Anchor and offset errors against a simulator's truth.toml; [effects] keys
+// it cannot compare are named as not compared, never refused.
 void print_truth_comparison(std::FILE* out, const Calibration& calibration, const Truth& truth);
+// Readings rejected as gross errors: row, sensor, cable, residual in sigmas.
+void print_gross_errors(std::FILE* out, const std::vector<SensorReading>& rejected);
+// Each planted gross error of truth.toml and whether it was rejected.
+void print_outlier_recall(std::FILE* out, const std::vector<SensorReading>& rejected,
+                          const std::vector<SensorReading>& planted);
 // The current UTC time in the RFC 3339 form calibration.toml uses.
 std::string utc_timestamp_now();
 

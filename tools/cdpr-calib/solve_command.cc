@@ -23,7 +23,8 @@ void add_solve_command(CLI::App& app, SolveArgs& args) {
                         " (e.g. catenary,elasticity,load_cell); fitted terms go to [effects]")
       ->check(model_validator())->capture_default_str();
   solve->add_option("--huber", args.huber_width,
-                    "robust Huber loss width in sigma units (0 = plain least squares)")
+                    "Huber loss width in sigma units on the final fit (0 = least squares); gross errors are found "
+                    "and left out without it (robust fit, then the rows of rejected readings refitted)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   solve->add_option("--height-sigma", args.height_sigma_m,
                     "sigma [m] of the catenary end-height consistency, Eq. (15)")
@@ -32,6 +33,14 @@ void add_solve_command(CLI::App& app, SolveArgs& args) {
       ->check(CLI::PositiveNumber)->capture_default_str();
   solve->add_option("--truth", args.truth_path, "truth.toml of a simulated data set: print the errors against it")
       ->check(CLI::ExistingFile);
+  solve->add_option("--max-rejected-fraction", args.max_rejected_fraction,
+                    "refuse the calibration when more than this fraction of the rows have gross errors")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  solve->add_flag("--no-robust", args.least_squares,
+                  "least squares (or --huber) alone: no robust fit, no gross errors found or left out");
+  solve->add_flag("--accept-misfit", args.accept_misfit,
+                  "exit 0 even when the model does not fit the data or the problem is under-determined (the "
+                  "calibration.toml says so in model_warning either way)");
   solve->add_flag("-q,--quiet", args.quiet, "no per-iteration progress lines");
 }
 
@@ -50,6 +59,8 @@ int run_solve(const SolveArgs& args) {
   options.huber_width = args.huber_width;
   options.height_sigma_m = args.height_sigma_m;
   options.max_iterations = args.max_iterations;
+  options.max_rejected_fraction = args.max_rejected_fraction;
+  options.robust = !args.least_squares;
   if (!args.quiet) options.progress = [](const IterationSummary& it) { print_iteration(stdout, it); };
 
   CalibrationResult result = calibrate(*robot, *samples, options);
@@ -77,6 +88,13 @@ int run_solve(const SolveArgs& args) {
       return 1;
     }
     print_truth_comparison(stdout, result.calibration, *truth);
+  }
+  if (result.misfit && !args.accept_misfit) {
+    std::fprintf(stderr,
+                 "cdpr-calib: %s\ncdpr-calib: the calibration was written but is not to be trusted as it is; "
+                 "run `cdpr-calib diagnose %s %s` to find the missing model term, or pass --accept-misfit\n",
+                 result.calibration.model_warning.c_str(), args.robot_path.c_str(), args.samples_path.c_str());
+    return 3;
   }
   return 0;
 }

@@ -19,10 +19,16 @@ struct SolveArgs {
   double height_sigma_m = 1e-2;
   int max_iterations = CalibrationOptions{}.max_iterations;
   bool quiet = false;
+  bool accept_misfit = false;
+  bool least_squares = false;  // --no-robust
+  double max_rejected_fraction = CalibrationOptions{}.max_rejected_fraction;
 };
 
 void add_solve_command(CLI::App& app, SolveArgs& args);
-// Returns the process exit code: 0 done, 1 bad input, 2 the fit failed.
+// Returns the process exit code: 0 done, 1 bad input, 2 the fit failed
+// (or was refused for too many gross errors), 3 the model does not fit (or
+// the problem is under-determined) and --accept-misfit was not given; the
+// calibration.toml is written in that case, with its model_warning.
 int run_solve(const SolveArgs& args);
 
 }  // namespace cdpr::tools

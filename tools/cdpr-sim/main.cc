@@ -54,6 +54,7 @@ struct Args {
   std::string preset = "large";
   std::string out_dir;
   std::string encoder_scale, com_offset, wind, workspace;
+  std::string encoder_outlier_range = "0.5,2", force_spike_range = "50,500";
   std::uint64_t seed = 1;
 };
 
@@ -99,6 +100,17 @@ int main(int argc, char** argv) {
   app.add_option("--noise-scale", config.noise_scale,
                  "multiplies every sensor sigma (encoder 10 mm, force 5 N large / 1 N small, pose 5 mm, 0.01 rad); 0 = noiseless")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--encoder-outliers", config.gross_errors.encoder_fraction,
+                 "fraction of rows with one gross encoder error (one cable, chosen at random; at least one row when "
+                 "> 0); listed in truth.toml [[outlier]]")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  app.add_option("--encoder-outlier-range", args.encoder_outlier_range,
+                 "min,max size [m] of a gross encoder error (sign at random)")->capture_default_str();
+  app.add_option("--force-spikes", config.gross_errors.force_fraction,
+                 "fraction of rows with a load-cell spike (at least one row when > 0); listed in truth.toml [[outlier]]")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  app.add_option("--force-spike-range", args.force_spike_range, "min,max size [N] of a load-cell spike (sign at random)")
+      ->capture_default_str();
   app.add_option("--segments", config.segments, "Simpson segments per cable in the equilibrium")
       ->check(CLI::PositiveNumber)->capture_default_str();
   CLI11_PARSE(app, argc, argv);
@@ -121,6 +133,19 @@ int main(int argc, char** argv) {
       return 1;
     }
     *target = Eigen::Vector3d(values[0], values[1], values[2]);
+  }
+
+  for (auto [text, low, high, name] :
+       {std::tuple{&args.encoder_outlier_range, &config.gross_errors.encoder_min_m, &config.gross_errors.encoder_max_m,
+                   "--encoder-outlier-range"},
+        std::tuple{&args.force_spike_range, &config.gross_errors.force_min_n, &config.gross_errors.force_max_n,
+                   "--force-spike-range"}}) {
+    if (!parse_list(*text, 2, values) || !(values[0] >= 0.0 && values[0] <= values[1])) {
+      std::fprintf(stderr, "cdpr-sim: %s: expected min,max with 0 <= min <= max\n", name);
+      return 1;
+    }
+    *low = values[0];
+    *high = values[1];
   }
 
   if (!args.workspace.empty()) {
@@ -151,7 +176,8 @@ int main(int argc, char** argv) {
   std::printf("wrote %s: %zu samples (%d candidate poses skipped), noise scale %g\n", (dir / "samples.csv").c_str(),
               data->samples.size(), data->skipped_candidates, config.noise_scale);
   if (!write_file(dir / "truth.toml", cdpr::formats::format_truth_toml(data->truth))) return 1;
-  std::printf("wrote %s: %zu hidden effects\n", (dir / "truth.toml").c_str(), data->truth.effects.size());
+  std::printf("wrote %s: %zu hidden effects, %zu planted gross errors\n", (dir / "truth.toml").c_str(),
+              data->truth.effects.size(), data->truth.outliers.size());
 
   double length_min = 1e300, length_max = 0.0, force_min = 1e300, force_max = 0.0;
   for (const cdpr::sim::Equilibrium& state : data->states) {

@@ -101,6 +101,7 @@ Expected<SimulatedDataset, std::string> simulate_dataset(const DatasetConfig& co
         measure(data.true_robot, f.state, config.noise_scale, noise, static_cast<int>(data.samples.size())));
     data.states.push_back(f.state);
   }
+  data.truth.outliers = plant_gross_errors(config.gross_errors, config.seed, data.nominal.reference_cable, data.samples);
   return data;
 }
 

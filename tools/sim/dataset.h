@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "sim/equilibrium.h"
+#include "sim/outliers.h"
 #include "sim/presets.h"
 #include "sim/true_robot.h"
 #include "solver/calibration.h"
@@ -43,6 +44,10 @@ struct DatasetConfig {
   // (solver/pose_design.h, A-optimal, judged with the NOMINAL anchors as a
   // planner must).
   int design_candidates = 0;
+  // Gross errors planted after the measurement (sim/outliers.h): a fraction
+  // of the rows with one encoder reading off by 0.5-2 m, a fraction with the
+  // load cell off by 50-500 N (either sign); listed in truth.toml.
+  GrossErrors gross_errors;
   int segments = 2000;                // sim/cable_shooting.h
   int max_candidates_per_pose = 20;   // give up after this many candidates per wanted pose
 };

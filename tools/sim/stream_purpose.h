@@ -13,5 +13,7 @@ inline constexpr std::uint64_t kStreamAnchorPerturbation = 2;
 inline constexpr std::uint64_t kStreamWaypointShift = 3;
 inline constexpr std::uint64_t kStreamWaypointYaw = 4;  // index: candidate
 inline constexpr std::uint64_t kStreamSensorNoise = 5;  // index: candidate
+inline constexpr std::uint64_t kStreamEncoderOutliers = 6;
+inline constexpr std::uint64_t kStreamForceSpikes = 7;
 
 }  // namespace cdpr::sim

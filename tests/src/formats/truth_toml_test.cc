@@ -55,6 +55,43 @@ TEST(TruthToml, UnknownKeyIsNamedWithItsLine) {
   EXPECT_EQ(truth.error().line, 11);  // the line after the example's 10
 }
 
+TEST(TruthToml, NonNumericEffectIsKeptAsNotCompared) {
+  // GIVEN an [effects] key with a boolean and one with a string (evaluation
+  // input from another simulator)
+  const std::string text = kExample + "massless = true\nsource = \"fem\"\n";
+  // WHEN it is parsed
+  const auto truth = parse_truth_toml(text, "truth.toml");
+  // THEN it is read, the numeric effect compared, the others named as not compared
+  ASSERT_TRUE(truth.has_value()) << truth.error().message();
+  EXPECT_EQ(truth->effects.size(), 1u);
+  EXPECT_EQ(truth->uncompared_effects, (std::vector<std::string>{"massless", "source"}));
+}
+
+TEST(TruthToml, PlantedOutliersRoundTrip) {
+  // GIVEN a truth with two planted gross errors
+  auto truth = parse_truth_toml(kExample, "truth.toml");
+  ASSERT_TRUE(truth.has_value());
+  truth->outliers = {{3, SensorKind::kEncoder, 2, -1.25}, {7, SensorKind::kForce, 0, 312.5}};
+  // WHEN it is formatted and parsed again
+  const auto again = parse_truth_toml(format_truth_toml(*truth), "again.toml");
+  // THEN the rows, sensors, cables and errors come back
+  ASSERT_TRUE(again.has_value()) << again.error().message();
+  ASSERT_EQ(again->outliers.size(), 2u);
+  EXPECT_EQ(again->outliers[0].row, 3);
+  EXPECT_EQ(again->outliers[0].sensor, SensorKind::kEncoder);
+  EXPECT_EQ(again->outliers[0].cable, 2);
+  EXPECT_EQ(again->outliers[0].value, -1.25);
+  EXPECT_EQ(again->outliers[1].sensor, SensorKind::kForce);
+  EXPECT_EQ(again->outliers[1].value, 312.5);
+}
+
+TEST(TruthToml, OutlierWithUnknownSensorIsRefused) {
+  const std::string text = kExample + "\n[[outlier]]\nrow = 1\nsensor = \"pose\"\ncable = 0\nerror = 1.0\n";
+  const auto truth = parse_truth_toml(text, "truth.toml");
+  ASSERT_FALSE(truth.has_value());
+  EXPECT_EQ(truth.error().field, "outlier[0].sensor");
+}
+
 TEST(TruthToml, MissingWinchesAreRefused) {
   // GIVEN only effects
   // WHEN it is parsed
