@@ -111,6 +111,13 @@ void DaemonLoop::track_run() {
   run_marker_error_ = error;
 }
 
+void DaemonLoop::log_device_faults() {
+  const std::string& faults = machine_->status().device_faults;
+  if (faults == logged_device_faults_) return;
+  if (log_) log_(faults.empty() ? std::string("device faults cleared") : "device faults: " + faults);
+  logged_device_faults_ = faults;
+}
+
 std::string DaemonLoop::handle_request(std::string_view line) {
   return control::respond(line, *machine_, store_, clock_.now_us());
 }
@@ -144,6 +151,7 @@ void DaemonLoop::step(hal::TimeUs now_us) {
   machine_->step(now_us);
   manage_solve(now_us);
   track_run();
+  log_device_faults();
   report(now_us);
   notifier_.watchdog();
 }

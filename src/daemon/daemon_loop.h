@@ -97,6 +97,9 @@ class DaemonLoop {
   void report_previous_state();
   // Keeps the run marker (run_marker.h) in step with the machine's run.
   void track_run();
+  // Logs the devices' latched faults (EMCY, 0x603F, a refused
+  // configuration) when they appear, change or are reset.
+  void log_device_faults();
 
   DaemonConfig config_;
   Robot robot_;
@@ -124,6 +127,7 @@ class DaemonLoop {
   RunMarker run_marker_now_;
   hal::TimeUs run_marker_started_us_ = -1;  // monotonic start of the run the marker describes
   std::string run_marker_error_;            // last logged write failure
+  std::string logged_device_faults_;        // as last logged
 };
 
 // RFC 3339 UTC time of the wall clock ("2026-11-22T10:15:00Z") for the

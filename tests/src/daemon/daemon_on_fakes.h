@@ -4,6 +4,7 @@
 // (control socket, start-up reports).
 
 #include <string>
+#include <vector>
 
 #include "../../fakes/fake_load_cell.h"
 #include "../../fakes/fake_pose_source.h"
@@ -28,12 +29,16 @@ class DaemonOnFakes {
   explicit DaemonOnFakes(const DaemonConfig& config)
       : load_cell_(clock_), pose_(clock_), store_(config.store),
         loop_(config, cdpr::test::large_robot(), DaemonDevices{winches_, load_cell_, pose_, nullptr}, store_, clock_,
-              notifier_, nullptr) {}
+              notifier_, [this](const std::string& line) { log_.push_back(line); }) {}
   hal::Status start() {
     if (!store_.open()) return hal::Status(hal::ErrorCode::kIoError, "store");
     return loop_.start();
   }
   DaemonLoop& loop() { return loop_; }
+  fakes::FakeWinchBank& winches() { return winches_; }
+  fakes::ManualClock& clock() { return clock_; }
+  // Every line the loop logged, in order.
+  const std::vector<std::string>& log() const { return log_; }
 
  private:
   fakes::ManualClock clock_{1'000'000};
@@ -42,6 +47,7 @@ class DaemonOnFakes {
   fakes::FakePoseSource pose_;
   SilentNotifier notifier_;
   store::CalibrationStore store_;
+  std::vector<std::string> log_;
   DaemonLoop loop_;
 };
 
