@@ -7,8 +7,6 @@
 // (plus its own settling lag), not drift on to the waypoint.
 
 #include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
@@ -16,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "daemon_process.h"
 #include "drivers/pose/pose_stream_source.h"
 #include "virtual_robot_rig.h"
 
@@ -61,24 +60,12 @@ TEST(HeartbeatLoss, DrivesStopWithinHeartbeatTimePlusBrakingAfterKill9) {
   std::atomic<bool> stop_robot{false};
   std::thread robot_thread([&] { robot->run(stop_robot); });
   std::ofstream(dir + "/cdpr-calibd.toml") << daemon_config(dir, *robot);
-  const std::string daemon = std::string(CDPR_BINARY_DIR) + "/src/cdpr-calibd";
-  const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    const std::string log = dir + "/daemon.log";
-    if (freopen(log.c_str(), "w", stderr) == nullptr) _exit(126);
-    execl(daemon.c_str(), daemon.c_str(), "--config", (dir + "/cdpr-calibd.toml").c_str(), static_cast<char*>(nullptr));
-    _exit(127);
-  }
+  ChildProcess daemon({built_program("src/cdpr-calibd"), "--config", dir + "/cdpr-calibd.toml"},
+                      dir + "/daemon.log");
   drivers::MonotonicClock clock;
   drivers::pose::PoseStreamSource pose(robot->pose_endpoint(), clock);
   ASSERT_TRUE(pose.open().ok());
-  const auto ask = [&](const std::string& request) {
-    calibctl::ControlClient client;
-    std::string error, response;
-    if (!client.connect(dir + "/control", error) || !client.request(request, response, error, 10'000)) return calibctl::JsonValue{};
-    return calibctl::JsonValue::parse(response).value_or(calibctl::JsonValue{});
-  };
+  const auto ask = [&](const std::string& request) { return ask_daemon(dir + "/control", request); };
   for (int i = 0; i < 100 && !std::filesystem::exists(dir + "/control"); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
   ASSERT_TRUE(ask("start")["ok"].boolean()) << "daemon log: " << dir << "/daemon.log";
 
@@ -107,9 +94,8 @@ TEST(HeartbeatLoss, DrivesStopWithinHeartbeatTimePlusBrakingAfterKill9) {
   const PosePoint before = track.size() > 50 ? track[track.size() - 50] : track.front();
   const PosePoint at_kill = track.back();
   const double platform_speed_mps = (at_kill.position - before.position).norm() / (at_kill.t_s - before.t_s);
-  ASSERT_EQ(kill(pid, SIGKILL), 0);
-  int wstatus = 0;
-  waitpid(pid, &wstatus, 0);
+  daemon.signal(SIGKILL);
+  ASSERT_EQ(daemon.wait_exit(std::chrono::seconds(5)), 128 + SIGKILL);
   const double kill_s = seconds();
   // AND the platform is watched for 6 s
   while (seconds() - kill_s < 6.0) {
