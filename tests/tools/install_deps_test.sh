@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # ctest tools.install_deps: tools/install-deps.sh against stub dpkg-query,
 # apt-get and id (first on PATH) that record their calls: nothing happens
-# when all is installed, only the missing packages are installed and never
-# with an upgrade, and an apt plan that would upgrade an installed package
-# installs nothing and names it.
+# when all is installed, only the missing packages are installed (with
+# --no-upgrade), an apt plan that upgrades an installed dependency names it
+# and goes on, and with INSTALL_DEPS_NO_UPGRADE it names it and installs
+# nothing.
 set -euo pipefail
 script=$(cd "$(dirname "$0")/../.." && pwd)/tools/install-deps.sh
 stubs=$(mktemp -d /tmp/cdpr-install-deps.XXXXXX)
@@ -47,13 +48,18 @@ install=$(grep -v -e update -e --simulate "$stubs/calls")
 [[ $install == *"--no-upgrade"* && $install == *" libfoo-dev libbar-dev" && $install != *cmake* ]] ||
   fail "missing packages: installed with '$install'"
 
-# A plan that upgrades an installed dependency: nothing installed, the upgrade named.
-run 'systemd install ok installed\n' \
-    'Inst libsystemd0 [252.19-1~deb12u1] (252.39-1~deb12u2 Debian-Security:12 [amd64])\nInst libsystemd-dev (252.39-1~deb12u2 Debian-Security:12 [amd64])\n' \
-    libsystemd-dev
-[[ $status -ne 0 ]] || fail "upgrade plan: exit 0"
+# A plan that upgrades an installed dependency: the upgrade named, then installed.
+upgrade_plan='Inst libsystemd0 [252.19-1~deb12u1] (252.39-1~deb12u2 Debian-Security:12 [amd64])\nInst libsystemd-dev (252.39-1~deb12u2 Debian-Security:12 [amd64])\n'
+run 'systemd install ok installed\n' "$upgrade_plan" libsystemd-dev
+[[ $status -eq 0 ]] || fail "upgrade plan: status $status: $(cat "$stubs/out")"
 grep -q 'libsystemd0 252.19-1~deb12u1 -> 252.39-1~deb12u2' "$stubs/out" || fail "upgrade plan: not named: $(cat "$stubs/out")"
-! grep -v -e update -e --simulate "$stubs/calls" | grep -q install || fail "upgrade plan: installed anyway"
+grep -v -e update -e --simulate "$stubs/calls" | grep -q ' libsystemd-dev$' || fail "upgrade plan: not installed"
+
+# The same plan with INSTALL_DEPS_NO_UPGRADE: named, nothing installed.
+INSTALL_DEPS_NO_UPGRADE=1 run 'systemd install ok installed\n' "$upgrade_plan" libsystemd-dev
+[[ $status -ne 0 ]] || fail "no-upgrade plan: exit 0"
+grep -q 'libsystemd0 252.19-1~deb12u1 -> 252.39-1~deb12u2' "$stubs/out" || fail "no-upgrade plan: not named: $(cat "$stubs/out")"
+! grep -v -e update -e --simulate "$stubs/calls" | grep -q install || fail "no-upgrade plan: installed anyway"
 
 # Dry run: the plan, nothing installed.
 export INSTALL_DEPS_DRY_RUN=1
@@ -61,4 +67,4 @@ run '' 'Inst libfoo-dev (1.0 Debian:12 [amd64])\n' libfoo-dev
 [[ $status -eq 0 ]] || fail "dry run failed: $(cat "$stubs/out")"
 grep -q 'would install: libfoo-dev' "$stubs/out" || fail "dry run: $(cat "$stubs/out")"
 ! grep -v -e update -e --simulate "$stubs/calls" | grep -q install || fail "dry run: installed anyway"
-echo "install-deps: only missing packages, never an upgrade"
+echo "install-deps: only missing packages, upgrades named (refused with INSTALL_DEPS_NO_UPGRADE)"
