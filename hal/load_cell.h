@@ -1,12 +1,12 @@
 #pragma once
-// The load cell on the reference cable (DESIGN.md: one, on Modbus RTU or TCP).
+// The load cell on the reference cable (docs/DESIGN.md: one, on Modbus RTU or TCP).
 //
 // Lifecycle: construct (configuration only, no I/O) -> open() -> read()* ->
 // close(). open() may be called again after close() or after a read() that
 // returned kNotConnected, to reconnect.
 //
 // Units: tension [N] along the cable at the winch, as the cell reports it (no
-// bias/gain correction here: those are calibration effects, DESIGN.md).
+// bias/gain correction here: those are calibration effects, docs/DESIGN.md).
 // Time: time_us is the local monotonic time (hal::Clock of the driver) when the
 // reply arrived.
 // Thread safety: one thread at a time per instance. Real-time safety: a bus

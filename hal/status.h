@@ -2,7 +2,7 @@
 // The result of every hardware call: ok, or an error code with a message for
 // the operator. Drivers translate errno, libmodbus and CANopen failures into
 // these codes at their boundary, so the daemon decides on the code (retry,
-// skip the waypoint, abort) and shows the message (STYLE.md "one policy per
+// skip the waypoint, abort) and shows the message (docs/STYLE.md "one policy per
 // layer"; ros2_control return_type).
 //
 // Real-time safety: an ok Status holds an empty std::string and does not

@@ -17,7 +17,7 @@
 //
 // Units: payout [m] of cable paid out from the winch as the encoder counts it
 // (relative: zero wherever the encoder's zero is; the calibration estimates
-// the offsets, DESIGN.md). Larger payout = longer free cable.
+// the offsets, docs/DESIGN.md). Larger payout = longer free cable.
 // Time: TimeUs of the injected hal::Clock, microseconds, monotonic.
 // Thread safety: one thread at a time per instance (the daemon loop).
 // Real-time safety: update(), status(), motion_finished() and the motion
@@ -76,7 +76,7 @@ class WinchBank {
  public:
   virtual ~WinchBank() = default;
 
-  // Number of winches, fixed at construction (4 on the robots of DESIGN.md).
+  // Number of winches, fixed at construction (4 on the robots of docs/DESIGN.md).
   virtual int winch_count() const = 0;
 
   // Connects the bus and starts the nodes (CANopen NMT start). Errors:

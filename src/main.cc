@@ -1,5 +1,5 @@
 // cdpr-calibd: the field self-calibration daemon of a cable robot
-// (DESIGN.md). main() alone chooses the drivers for the hal interfaces
+// (docs/DESIGN.md). main() alone chooses the drivers for the hal interfaces
 // from the configuration, then hands everything to the event loop
 // (src/daemon/daemon_loop.h).
 //

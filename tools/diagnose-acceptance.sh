@@ -1,5 +1,5 @@
 #!/bin/bash
-# Issue 6's acceptance table for `cdpr-calib diagnose`: simulated data sets
+# The acceptance table for `cdpr-calib diagnose`: simulated data sets
 # (default noise) with effects hidden by cdpr-sim, one diagnose run each, on
 # the large robot (nominal anchors 2 m off) except where a case says
 # "small robot": the small robot (nominal anchors 0.5 m off) posed over its

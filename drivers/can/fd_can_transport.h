@@ -1,6 +1,6 @@
 #pragma once
 // CanTransport over a file descriptor carrying Linux `struct can_frame`
-// records, for both transports of the issue:
+// records, for both transports the daemon uses:
 //   * SocketCAN: a PF_CAN/SOCK_RAW/CAN_RAW socket bound to an interface
 //     (open_socketcan). Each read/write is one record.
 //   * Unix stream socket to the virtual robot (connect_unix, or adopt an fd

@@ -1,5 +1,5 @@
 #pragma once
-// errno -> hal::Status at the driver boundary (STYLE.md: translate errno into
+// errno -> hal::Status at the driver boundary (docs/STYLE.md: translate errno into
 // our own error). The message names the device and the failed operation.
 
 #include <string_view>

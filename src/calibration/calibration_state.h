@@ -1,5 +1,5 @@
 #pragma once
-// The states of one field calibration (DESIGN.md "Data flow") and the
+// The states of one field calibration (docs/DESIGN.md "Data flow") and the
 // status the daemon reports on the control socket.
 
 #include <string>

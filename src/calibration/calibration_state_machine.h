@@ -1,5 +1,5 @@
 #pragma once
-// The one-button field calibration (DESIGN.md "Data flow"), as an explicit
+// The one-button field calibration (docs/DESIGN.md "Data flow"), as an explicit
 // state machine driven by step(now_us): pure logic with time passed in; all
 // I/O goes through the hal interfaces and the store.
 //

@@ -1,6 +1,6 @@
 #pragma once
 // Decides when the platform has come to rest at a waypoint, and averages the
-// rest window into one sample row (samples.csv, FORMATS.md).
+// rest window into one sample row (samples.csv, docs/FORMATS.md).
 //
 // Settled means, over the last `window_us` of observations:
 //  - the window is covered (oldest observation at least window_us older than
@@ -14,7 +14,7 @@
 //    between neighbouring bins over the time between their centres. A platform
 //    still moving or swinging slowly shows up there; white noise is averaged
 //    down by the samples per bin.
-// One observation under a threshold is never enough (STYLE.md).
+// One observation under a threshold is never enough (docs/STYLE.md).
 //
 // Memory: a fixed-capacity ring allocated at construction; add(), check()
 // and average() never allocate. When more than `capacity` observations fall in

@@ -1,8 +1,8 @@
 #pragma once
 // Accepts or refuses a calibration before it may replace the stored one
-// (DESIGN.md step 5). A refused fit is never committed; every reason is
-// stated so the operator knows what to fix (more waypoints, a loose cable, a
-// moved pulley, a noisy sensor).
+// (docs/DESIGN.md, data flow step 6). A refused fit is never committed;
+// every reason is stated so the operator knows what to fix (more waypoints,
+// a loose cable, a moved pulley, a noisy sensor).
 //
 // Checks, each with its own reason when it fails:
 //  - the solver converged (kConverged; kMaxIterations only if allowed);

@@ -1,6 +1,6 @@
 #pragma once
 // Plans the static poses of one field calibration from the nominal geometry
-// (DESIGN.md step 3): well spread over the workspace so that anchors and
+// (docs/DESIGN.md step 3): well spread over the workspace so that anchors and
 // offsets are observable, each converted to winch payout targets with the
 // sagging-cable model (static_pose.h) and checked against the limits.
 //
@@ -43,9 +43,8 @@ enum class WaypointSelection {
   kSpread,
   // A-optimal (solver/pose_design.h): each the one that lowers the summed
   // Cramer-Rao variance of anchors and offsets most, on the nominal anchors.
-  // Large robot, default workspace, 35 of 186 feasible candidates: anchor
-  // sigma norm 0.047 -> 0.040 m, offset sigma 0.038 -> 0.031 m (straight-
-  // cable bound); poses crowd towards the workspace's edges.
+  // Smaller anchor and offset sigmas than kSpread for the same count
+  // (docs/calibration.md); poses crowd towards the workspace's edges.
   kInformative,
 };
 

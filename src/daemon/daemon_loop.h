@@ -1,6 +1,6 @@
 #pragma once
 // cdpr-calibd's event loop: the OS wiring around the pure state machine
-// (STYLE.md: logic apart from the module wrapper, as PX4's
+// (docs/STYLE.md: logic apart from the module wrapper, as PX4's
 // mc_att_control beside its module).
 //
 // Every period (config [loop] period_ms) it

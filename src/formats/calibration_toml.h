@@ -1,5 +1,5 @@
 #pragma once
-// calibration.toml and truth.toml (FORMATS.md): parse and format.
+// calibration.toml and truth.toml (docs/FORMATS.md): parse and format.
 
 #include <string>
 #include <string_view>

@@ -1,5 +1,5 @@
 #pragma once
-// The [effects] table shared by calibration.toml and truth.toml (FORMATS.md):
+// The [effects] table shared by calibration.toml and truth.toml (docs/FORMATS.md):
 // fitted (or true) parameters of extra model terms, by name. Each value is a
 // number (scalar terms, e.g. axial_stiffness) or an array of numbers
 // (per-cable terms, e.g. encoder_scale). Names are open-ended: which effects

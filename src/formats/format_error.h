@@ -1,5 +1,5 @@
 #pragma once
-// Why a data file (FORMATS.md) was refused: which file, which line, which
+// Why a data file (docs/FORMATS.md) was refused: which file, which line, which
 // key or column, and what was wrong with it.
 
 #include <string>

@@ -1,5 +1,5 @@
 #pragma once
-// samples.csv (FORMATS.md): one row per static pose. Columns are matched by
+// samples.csv (docs/FORMATS.md): one row per static pose. Columns are matched by
 // header name; a missing, non-finite or extra value is refused with the row
 // (file line) and column; rows are never silently dropped.
 

@@ -1,5 +1,5 @@
 #pragma once
-// Whole-file reads for the data formats (FORMATS.md). Data files are small
+// Whole-file reads for the data formats (docs/FORMATS.md). Data files are small
 // (kilobytes), so each parser works on the complete text in memory.
 
 #include <string>

@@ -1,6 +1,6 @@
 #pragma once
 // Validated reads from a parsed TOML document, shared by the robot.toml,
-// calibration.toml and truth.toml parsers (FORMATS.md).
+// calibration.toml and truth.toml parsers (docs/FORMATS.md).
 //
 // Error policy: the first problem is recorded as a FormatError naming the
 // file, the line and the dotted key ("winch[2].anchor"; tables of an array

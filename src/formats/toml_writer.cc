@@ -12,7 +12,7 @@
 namespace cdpr::formats {
 namespace {
 
-constexpr std::size_t kCommentColumn = 35;  // FORMATS.md aligns comments here
+constexpr std::size_t kCommentColumn = 35;  // docs/FORMATS.md aligns comments here
 
 template <class T, class Format>
 std::string toml_array(const std::vector<T>& values, Format format) {

@@ -1,5 +1,5 @@
 #pragma once
-// Text pieces for writing the TOML formats of FORMATS.md by hand, so the
+// Text pieces for writing the TOML formats of docs/FORMATS.md by hand, so the
 // files keep the documented layout and comments (a TOML library's
 // serializer would reorder keys and drop comments).
 //
@@ -23,7 +23,7 @@ std::string toml_string(std::string_view value);              // quoted, escaped
 std::string toml_strings(const std::vector<std::string>& values);
 std::string toml_key(std::string_view key);  // bare if possible, quoted otherwise
 
-// Appends "assignment   # comment\n", comments aligned in one column as in FORMATS.md.
+// Appends "assignment   # comment\n", comments aligned in one column as in docs/FORMATS.md.
 void append_line(std::string& out, std::string_view assignment, std::string_view comment = {});
 
 // True when `text` is a TOML offset date-time (RFC 3339 with a zone), e.g.

@@ -1,4 +1,4 @@
-// truth.toml (FORMATS.md): the ground truth a simulator wrote next to its
+// truth.toml (docs/FORMATS.md): the ground truth a simulator wrote next to its
 // data set; read only by evaluation, never by calibration.
 #include "src/formats/calibration_toml.h"
 

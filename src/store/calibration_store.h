@@ -9,7 +9,7 @@
 // after a commit, an older one after a rollback). The history keeps the
 // newest `history_depth + 1` versions (the current plus N previous), and
 // never prunes the entry equal to the current file. The format version is the
-// `format` key inside each file (FORMATS.md); every file is parsed before it is
+// `format` key inside each file (docs/FORMATS.md); every file is parsed before it is
 // written and after it is read, so a corrupt or newer file is refused.
 //
 // Atomicity (src/store/atomic_file.h): commit = history entry written

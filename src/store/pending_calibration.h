@@ -3,7 +3,7 @@
 // history directory), kept so that the run's work is not lost:
 //
 //   <state_dir>/pending/calibration.toml   the fit, exactly as it would have been committed
-//   <state_dir>/pending/samples.csv        the samples it was fitted to (FORMATS.md)
+//   <state_dir>/pending/samples.csv        the samples it was fitted to (docs/FORMATS.md)
 //
 // Each file is written atomically (atomic_file.h), samples first, so a
 // calibration.toml there always has its samples beside it. Once the cause is

@@ -1,4 +1,4 @@
-// The acceptance test of issue 5: the daemon with its real drivers calibrates
+// The end-to-end field calibration: the daemon with its real drivers calibrates
 // the virtual robot (large preset, 35 waypoints) over real sockets, started
 // and followed through the control socket; the committed anchors must lie
 // within 0.10 m of the virtual robot's truth, and status is answered within

@@ -1,4 +1,4 @@
-// Issue 15's safety case, at time scale 1: cdpr-calibd (the real program,
+// The heartbeat-loss safety case, at time scale 1: cdpr-calibd (the real program,
 // its own process) moves the virtual robot's winches; it is killed with
 // SIGKILL in the middle of a move. The drives then hear no master
 // heartbeat: after their consumer heartbeat time (0x1016, 500 ms) they

@@ -89,7 +89,7 @@ inline void use_small_robot_limits(daemon::DaemonConfig& config) {
   planner.z_max_m = 18.0;
 }
 
-// Issue 5's acceptance scenario: the large robot, seed 1, nominal anchors
+// The field calibration's acceptance scenario: the large robot, seed 1, nominal anchors
 // 0.3 m off the truth, physics 20x faster than real time. The test that runs
 // it and the one that checks its plan share it, so both see the same robot.
 inline virtual_robot::VirtualRobotOptions large_robot_acceptance_options() {

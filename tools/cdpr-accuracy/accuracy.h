@@ -1,5 +1,5 @@
 #pragma once
-// Calibration accuracy over many simulated data sets (issue 4's acceptance):
+// Calibration accuracy over many simulated data sets (docs/calibration.md):
 // every run counts; a run whose fit fails is scored as if the nominal
 // anchors and zero offsets had been kept.
 

@@ -1,5 +1,5 @@
 #pragma once
-// A whole simulated calibration data set: the three files of FORMATS.md
+// A whole simulated calibration data set: the three files of docs/FORMATS.md
 // (robot.toml, samples.csv, truth.toml) as values, plus the true state at
 // every sample for model checks (e.g. the paper's Table I).
 //

@@ -4,9 +4,9 @@
 //   enc_i  = (1 + s_i) * payout_i + offset_i + N(0, (k sigma_enc)^2)
 //            payout_i = CableEquilibrium::payout_m: unstretched cable from the
 //            anchor point A over the pulley (if any) to the attachment. The
-//            encoders count unstretched cable (DESIGN.md); for inextensible
+//            encoders count unstretched cable (docs/DESIGN.md); for inextensible
 //            cables this IS the true arc length from A to the attachment
-//            (free catenary + wrapped pulley arc), as FORMATS.md defines.
+//            (free catenary + wrapped pulley arc), as docs/FORMATS.md defines.
 //   force  = (1 + gain) * |F_b,ref| + bias + N(0, (k sigma_force)^2)
 //            |F_b,ref|: tension of the reference cable at its attachment.
 //   position    = true + N(0, (k sigma_pos)^2 I)

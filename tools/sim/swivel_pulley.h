@@ -1,5 +1,5 @@
 #pragma once
-// Where the free cable leaves a swivel pulley (DESIGN.md "Swivel pulley").
+// Where the free cable leaves a swivel pulley (docs/DESIGN.md "Swivel pulley").
 //
 // The swivel axis is vertical through the fixed anchor point A; the cable
 // comes up along that axis and touches the pulley at A. The pulley (radius r)

@@ -1,7 +1,7 @@
 #pragma once
 // The robot as it really is in a simulation: its geometry with the TRUE
 // anchors, the true encoder offsets and the true values of the effects the
-// nominal robot.toml does not describe (DESIGN.md "Model terms").
+// nominal robot.toml does not describe (docs/DESIGN.md "Model terms").
 
 #include <array>
 #include <limits>
@@ -50,7 +50,7 @@ struct TrueRobot {
   double platform_weight_n() const { return robot.platform_mass_kg * robot.gravity_mps2; }
 };
 
-// The [effects] table of truth.toml (FORMATS.md): only effects that are
+// The [effects] table of truth.toml (docs/FORMATS.md): only effects that are
 // present, by name: axial_stiffness [N], encoder_scale (4), force_bias [N],
 // force_gain, com_offset (3) [m], density_error, pulley_radius [m],
 // wind_force (3) [N].

@@ -7,7 +7,7 @@
 //
 // Units and conventions: payout [m] in encoder units, as the robot's
 // encoders count it: payout_i = unstretched cable from the anchor point to
-// the attachment + true encoder offset_i (FORMATS.md enc_i). The
+// the attachment + true encoder offset_i (docs/FORMATS.md enc_i). The
 // equilibrium is recomputed whenever the cables have moved, at most every
 // equilibrium_interval_s of simulated time; between solves the platform
 // relaxes towards the latest equilibrium with time constant

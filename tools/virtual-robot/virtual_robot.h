@@ -1,7 +1,7 @@
 #pragma once
 // The virtual robot: a simulated cable robot that speaks the real robot's
 // protocols, so cdpr-calibd runs against it unchanged but for its endpoints
-// (DESIGN.md "Where this runs").
+// (docs/DESIGN.md "Where this runs").
 //
 //   <dir>/can.sock    CAN frames over a Unix stream socket (the record format
 //                     of drivers/can/fd_can_transport.h): 4 CiA 402 drives and

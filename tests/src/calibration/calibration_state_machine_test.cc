@@ -1,7 +1,6 @@
 // Component tests of the calibration state machine against behavioural fakes
-// and an injected clock (issue 5 acceptance): every fault ends with the
-// winches stopped, a clear reason, and the previous calibration intact byte
-// for byte.
+// and an injected clock: every fault ends with the winches stopped, a clear
+// reason, and the previous calibration intact byte for byte.
 
 #include "src/calibration/calibration_state_machine.h"
 

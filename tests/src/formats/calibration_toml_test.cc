@@ -10,7 +10,7 @@
 namespace cdpr::formats {
 namespace {
 
-// The calibration.toml example of FORMATS.md with a second winch and an
+// The calibration.toml example of docs/FORMATS.md with a second winch and an
 // [effects] table.
 const std::string kExample = R"(format = 1
 created = 2026-11-22T10:15:00Z

@@ -10,7 +10,7 @@
 namespace cdpr::formats {
 namespace {
 
-// The robot.toml example of FORMATS.md, verbatim but for three more winches
+// The robot.toml example of docs/FORMATS.md, verbatim but for three more winches
 // (the solver needs four cables).
 const std::string kExample = R"(name = "large"                     # free text
 gravity = 9.81                     # m/s^2, optional, default 9.81

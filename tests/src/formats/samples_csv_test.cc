@@ -11,7 +11,7 @@
 namespace cdpr::formats {
 namespace {
 
-// The samples.csv example of FORMATS.md plus a second row.
+// The samples.csv example of docs/FORMATS.md plus a second row.
 const std::string kExample =
     "# lines starting with '#' are comments\n"
     "sample,x,y,z,qw,qx,qy,qz,enc0,enc1,enc2,enc3,force\n"

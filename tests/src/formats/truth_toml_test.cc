@@ -8,7 +8,7 @@
 namespace cdpr::formats {
 namespace {
 
-// The truth.toml example of FORMATS.md with its effect uncommented and a second winch.
+// The truth.toml example of docs/FORMATS.md with its effect uncommented and a second winch.
 const std::string kExample = R"([[winch]]
 anchor = [0.0, 0.0, 50.0]          # m, true pulley exit point
 offset = 3.2                       # m, true encoder offset
