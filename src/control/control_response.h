@@ -6,9 +6,10 @@
 //   start/abort/rollback/commit {"ok":true,"message":"started"}
 //   status   {"ok":true,"state":"settle","running":true,"waypoint":3,"waypoints":35,
 //             "samples":2,"skipped":0,"progress":0.12,"elapsed_s":41.2,
-//             "reason":"","note":"","detail":"platform moving: ...","committed_seq":0,
-//             "interrupted":"","store_problems":[],"pending_commit":false}
+//             "reason":"","note":"","detail":"platform moving: ...","device_faults":"",
+//             "committed_seq":0,"interrupted":"","store_problems":[],"pending_commit":false}
 //            elapsed_s: since the last run started (to its end when finished); null if never run
+//            device_faults: the devices' latched faults until reset-faults ("" when none)
 //            interrupted: "run interrupted at <time>, waypoint k of n ..." when a daemon died
 //            mid-run, until the next start; store_problems: unreadable stored files, one
 //            sentence each; pending_commit: a failed commit's fit waits for `commit`
@@ -19,7 +20,9 @@
 //            {"ok":true,"present":false} when nothing was ever committed
 //   history  {"ok":true,"history":[{"seq":4,"current":true,"valid":true,"created":"..","robot":"..",
 //             "samples":35,"problem":""},...]}   newest first
-// Units as in calibration.toml (m, N); progress in [0, 1].
+// Units as in calibration.toml (m, N); progress in [0, 1]. Members come in
+// the order shown; numbers are the shortest text that reads back exactly
+// (1e-04, 41), non-finite ones null.
 
 #include <optional>
 #include <string>

@@ -17,7 +17,8 @@ void append_if(std::string& out, const char* label, const JsonValue& text) {
 }
 
 double at(const JsonValue& vector, std::size_t k) {
-  return k < vector.array().size() ? vector.array()[k].number() : 0.0;
+  const auto elements = vector.array();
+  return k < elements.size() ? elements[k].number() : 0.0;
 }
 
 }  // namespace
