@@ -136,6 +136,17 @@ std::string format_show_response(const std::optional<store::CurrentCalibration>&
     fit["rms_encoder"] = c.fit.rms_encoder_m;
     fit["rms_force"] = c.fit.rms_force_n;
     json["fit"] = std::move(fit);
+    json["model_warning"] = c.model_warning;
+    Json rejected = Json::array();
+    for (const SensorReading& r : c.rejected) {
+      Json reading;
+      reading["row"] = r.row;
+      reading["sensor"] = sensor_name(r.sensor);
+      reading["cable"] = r.cable;
+      reading["residual"] = r.value;
+      rejected.push_back(std::move(reading));
+    }
+    json["rejected"] = std::move(rejected);
   }
   return line(json);
 }

@@ -16,7 +16,11 @@
 //   show     {"ok":true,"present":true,"seq":4,"created":"2026-11-22T10:15:00Z","robot":"large",
 //             "model":["catenary"],"samples":35,
 //             "winches":[{"anchor":[x,y,z],"anchor_sigma":[..],"offset":3.2,"offset_sigma":0.03},...],
-//             "fit":{"cost_initial":..,"cost_final":..,"iterations":14,"rms_encoder":..,"rms_force":..}}
+//             "fit":{"cost_initial":..,"cost_final":..,"iterations":14,"rms_encoder":..,"rms_force":..},
+//             "model_warning":"","rejected":[{"row":12,"sensor":"encoder","cable":3,"residual":-95.4},...]}
+//            model_warning: why the model does not fit the data ("" when it fits); rejected: the
+//            readings left out of the fit as gross errors (calibration.toml [[rejected]]; residual
+//            in sigmas at the robust fit)
 //            {"ok":true,"present":false} when nothing was ever committed
 //   history  {"ok":true,"history":[{"seq":4,"current":true,"valid":true,"created":"..","robot":"..",
 //             "samples":35,"problem":""},...]}   newest first
