@@ -10,7 +10,7 @@ comma      := ,
 
 # Debian packages the project needs; see README.md for why each is here.
 DEB_PACKAGES := build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev \
-                libmodbus-dev libsystemd-dev libtomlplusplus-dev libcli11-dev \
+                libmodbus-dev libsystemd-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev \
                 libgtest-dev libgmock-dev libbenchmark-dev libgpiod-dev systemd \
                 mbpoll libseccomp-dev bubblewrap lintian
 # mbpoll: a Modbus master neither the daemon nor the virtual robot shares

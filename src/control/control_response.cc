@@ -1,101 +1,172 @@
 #include "src/control/control_response.h"
 
-#include <limits>
+#include <cmath>
 
 #include <Eigen/Core>
+#include <nlohmann/json.hpp>
 
-#include "src/control/json_writer.h"
+#include "src/formats/number_text.h"
 
 namespace cdpr::control {
 namespace {
 
-JsonWriter& vector3(JsonWriter& json, const Eigen::Vector3d& v) {
-  return json.begin_array().value(v.x()).value(v.y()).value(v.z()).end_array();
+// Members keep the order they are added in: the order is part of the
+// protocol (clients and tests compare whole lines).
+using Json = nlohmann::ordered_json;
+
+// `value` as one line of JSON. Strings go through nlohmann (escaped, invalid
+// UTF-8 replaced by U+FFFD, so no newline and no invalid text whatever a
+// path or errno message holds). Floating-point numbers are written as the
+// shortest text that reads back exactly (formats::shortest_text, as in the
+// data files: 41 and 1e-04, where nlohmann writes 41.0 and 0.0001);
+// non-finite ones as null.
+void append_line_json(const Json& value, std::string& out) {
+  switch (value.type()) {
+    case Json::value_t::object: {
+      out += '{';
+      for (auto member = value.begin(); member != value.end(); ++member) {
+        if (member != value.begin()) out += ',';
+        append_line_json(Json(member.key()), out);
+        out += ':';
+        append_line_json(member.value(), out);
+      }
+      out += '}';
+      return;
+    }
+    case Json::value_t::array: {
+      out += '[';
+      for (auto element = value.begin(); element != value.end(); ++element) {
+        if (element != value.begin()) out += ',';
+        append_line_json(*element, out);
+      }
+      out += ']';
+      return;
+    }
+    case Json::value_t::number_float: {
+      const double number = value.get<double>();
+      out += std::isfinite(number) ? formats::shortest_text(number) : "null";
+      return;
+    }
+    default: out += value.dump(-1, ' ', false, Json::error_handler_t::replace);
+  }
 }
 
-std::string line(const JsonWriter& json) { return json.text() + "\n"; }
+std::string line(const Json& value) {
+  std::string out;
+  append_line_json(value, out);
+  return out + "\n";
+}
+
+Json vector3(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+Json string_array(const std::vector<std::string>& texts) {
+  Json array = Json::array();
+  for (const std::string& text : texts) array.push_back(text);
+  return array;
+}
 
 }  // namespace
 
 std::string format_error_response(std::string_view reason) {
-  JsonWriter json;
-  json.begin_object().key("ok").value(false).key("error").value(reason).end_object();
+  Json json;
+  json["ok"] = false;
+  json["error"] = std::string(reason);
   return line(json);
 }
 
 std::string format_ok_response(std::string_view message) {
-  JsonWriter json;
-  json.begin_object().key("ok").value(true).key("message").value(message).end_object();
+  Json json;
+  json["ok"] = true;
+  json["message"] = std::string(message);
   return line(json);
 }
 
 std::string format_status_response(const calibration::CalibrationStatus& status, hal::TimeUs now_us) {
-  JsonWriter json;
-  json.begin_object().key("ok").value(true);
-  json.key("state").value(calibration::to_string(status.state));
-  json.key("running").value(calibration::is_running(status.state));
-  json.key("waypoint").value(status.waypoint).key("waypoints").value(status.waypoint_count);
-  json.key("samples").value(status.samples).key("skipped").value(status.skipped);
-  json.key("progress").value(status.progress);
-  json.key("elapsed_s");
+  Json json;
+  json["ok"] = true;
+  json["state"] = calibration::to_string(status.state);
+  json["running"] = calibration::is_running(status.state);
+  json["waypoint"] = status.waypoint;
+  json["waypoints"] = status.waypoint_count;
+  json["samples"] = status.samples;
+  json["skipped"] = status.skipped;
+  json["progress"] = status.progress;
   if (status.started_us < 0) {
-    json.value(std::numeric_limits<double>::quiet_NaN());  // null
+    json["elapsed_s"] = nullptr;
   } else {
     const hal::TimeUs end_us = status.finished_us >= 0 ? status.finished_us : now_us;
-    json.value(1e-6 * static_cast<double>(end_us - status.started_us));
+    json["elapsed_s"] = 1e-6 * static_cast<double>(end_us - status.started_us);
   }
-  json.key("reason").value(status.reason).key("note").value(status.note).key("detail").value(status.detail);
-  json.key("device_faults").value(status.device_faults);
-  json.key("committed_seq").value(status.committed_seq);
-  json.key("interrupted").value(status.interrupted);
-  json.key("store_problems").begin_array();
-  for (const std::string& problem : status.store_problems) json.value(problem);
-  json.end_array();
-  json.key("pending_commit").value(status.pending_commit);
-  json.end_object();
+  json["reason"] = status.reason;
+  json["note"] = status.note;
+  json["detail"] = status.detail;
+  json["device_faults"] = status.device_faults;
+  json["committed_seq"] = status.committed_seq;
+  json["interrupted"] = status.interrupted;
+  json["store_problems"] = string_array(status.store_problems);
+  json["pending_commit"] = status.pending_commit;
   return line(json);
 }
 
 std::string format_show_response(const std::optional<store::CurrentCalibration>& current) {
-  JsonWriter json;
-  json.begin_object().key("ok").value(true).key("present").value(current.has_value());
+  Json json;
+  json["ok"] = true;
+  json["present"] = current.has_value();
   if (current) {
     const Calibration& c = current->calibration;
-    json.key("seq").value(current->seq).key("created").value(c.created).key("robot").value(c.robot);
-    json.key("model").begin_array();
-    for (const std::string& term : c.model) json.value(term);
-    json.end_array();
-    json.key("samples").value(c.samples);
-    json.key("winches").begin_array();
+    json["seq"] = current->seq;
+    json["created"] = c.created;
+    json["robot"] = c.robot;
+    json["model"] = string_array(c.model);
+    json["samples"] = c.samples;
+    Json winches = Json::array();
     for (const WinchCalibration& w : c.winches) {
-      json.begin_object();
-      vector3(json.key("anchor"), w.anchor_world);
-      vector3(json.key("anchor_sigma"), w.anchor_sigma);
-      json.key("offset").value(w.offset_m).key("offset_sigma").value(w.offset_sigma_m);
-      json.end_object();
+      Json winch;
+      winch["anchor"] = vector3(w.anchor_world);
+      winch["anchor_sigma"] = vector3(w.anchor_sigma);
+      winch["offset"] = w.offset_m;
+      winch["offset_sigma"] = w.offset_sigma_m;
+      winches.push_back(std::move(winch));
     }
-    json.end_array();
-    json.key("fit").begin_object();
-    json.key("cost_initial").value(c.fit.cost_initial).key("cost_final").value(c.fit.cost_final);
-    json.key("iterations").value(c.fit.iterations);
-    json.key("rms_encoder").value(c.fit.rms_encoder_m).key("rms_force").value(c.fit.rms_force_n);
-    json.end_object();
+    json["winches"] = std::move(winches);
+    Json fit;
+    fit["cost_initial"] = c.fit.cost_initial;
+    fit["cost_final"] = c.fit.cost_final;
+    fit["iterations"] = c.fit.iterations;
+    fit["rms_encoder"] = c.fit.rms_encoder_m;
+    fit["rms_force"] = c.fit.rms_force_n;
+    json["fit"] = std::move(fit);
+    json["model_warning"] = c.model_warning;
+    Json rejected = Json::array();
+    for (const SensorReading& r : c.rejected) {
+      Json reading;
+      reading["row"] = r.row;
+      reading["sensor"] = sensor_name(r.sensor);
+      reading["cable"] = r.cable;
+      reading["residual"] = r.value;
+      rejected.push_back(std::move(reading));
+    }
+    json["rejected"] = std::move(rejected);
   }
-  json.end_object();
   return line(json);
 }
 
 std::string format_history_response(const std::vector<store::HistoryEntry>& history) {
-  JsonWriter json;
-  json.begin_object().key("ok").value(true).key("history").begin_array();
+  Json entries = Json::array();
   for (const store::HistoryEntry& entry : history) {
-    json.begin_object();
-    json.key("seq").value(entry.seq).key("current").value(entry.current).key("valid").value(entry.valid);
-    json.key("created").value(entry.created).key("robot").value(entry.robot).key("samples").value(entry.samples);
-    json.key("problem").value(entry.problem);
-    json.end_object();
+    Json item;
+    item["seq"] = entry.seq;
+    item["current"] = entry.current;
+    item["valid"] = entry.valid;
+    item["created"] = entry.created;
+    item["robot"] = entry.robot;
+    item["samples"] = entry.samples;
+    item["problem"] = entry.problem;
+    entries.push_back(std::move(item));
   }
-  json.end_array().end_object();
+  Json json;
+  json["ok"] = true;
+  json["history"] = std::move(entries);
   return line(json);
 }
 

@@ -6,20 +6,27 @@
 //   start/abort/rollback/commit {"ok":true,"message":"started"}
 //   status   {"ok":true,"state":"settle","running":true,"waypoint":3,"waypoints":35,
 //             "samples":2,"skipped":0,"progress":0.12,"elapsed_s":41.2,
-//             "reason":"","note":"","detail":"platform moving: ...","committed_seq":0,
-//             "interrupted":"","store_problems":[],"pending_commit":false}
+//             "reason":"","note":"","detail":"platform moving: ...","device_faults":"",
+//             "committed_seq":0,"interrupted":"","store_problems":[],"pending_commit":false}
 //            elapsed_s: since the last run started (to its end when finished); null if never run
+//            device_faults: the devices' latched faults until reset-faults ("" when none)
 //            interrupted: "run interrupted at <time>, waypoint k of n ..." when a daemon died
 //            mid-run, until the next start; store_problems: unreadable stored files, one
 //            sentence each; pending_commit: a failed commit's fit waits for `commit`
 //   show     {"ok":true,"present":true,"seq":4,"created":"2026-11-22T10:15:00Z","robot":"large",
 //             "model":["catenary"],"samples":35,
 //             "winches":[{"anchor":[x,y,z],"anchor_sigma":[..],"offset":3.2,"offset_sigma":0.03},...],
-//             "fit":{"cost_initial":..,"cost_final":..,"iterations":14,"rms_encoder":..,"rms_force":..}}
+//             "fit":{"cost_initial":..,"cost_final":..,"iterations":14,"rms_encoder":..,"rms_force":..},
+//             "model_warning":"","rejected":[{"row":12,"sensor":"encoder","cable":3,"residual":-95.4},...]}
+//            model_warning: why the model does not fit the data ("" when it fits); rejected: the
+//            readings left out of the fit as gross errors (calibration.toml [[rejected]]; residual
+//            in sigmas at the robust fit)
 //            {"ok":true,"present":false} when nothing was ever committed
 //   history  {"ok":true,"history":[{"seq":4,"current":true,"valid":true,"created":"..","robot":"..",
 //             "samples":35,"problem":""},...]}   newest first
-// Units as in calibration.toml (m, N); progress in [0, 1].
+// Units as in calibration.toml (m, N); progress in [0, 1]. Members come in
+// the order shown; numbers are the shortest text that reads back exactly
+// (1e-04, 41), non-finite ones null.
 
 #include <optional>
 #include <string>

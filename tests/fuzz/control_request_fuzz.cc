@@ -13,7 +13,7 @@
 
 #include "fuzz_check.h"
 #include "src/control/control_request.h"
-#include "src/control/json_writer.h"
+#include "src/control/control_response.h"
 #include "src/control/line_assembler.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -27,9 +27,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     require(line.size() <= kMaxRequestBytes + 2, "lines handed on are within the limit");
     const auto request = parse_request(line);
     if (!request) {
-      const std::string response = json_string(request.error());
+      const std::string response = format_error_response(request.error());
       require(!request.error().empty(), "a refusal names its reason");
-      require(response.find('\n') == std::string::npos, "the error response is one line");
+      require(response.find('\n') == response.size() - 1, "the error response is one line");
     } else if (request->kind == RequestKind::kRollback) {
       require(request->seq >= 1, "rollback targets a sequence number >= 1");
     }

@@ -2,7 +2,8 @@
 // control socket served in this process: with --json every outcome, a
 // failure too, is one JSON object on stdout; --json may follow the
 // subcommand; a permission error names the group that may control the
-// daemon instead of suggesting it is not running.
+// daemon instead of suggesting it is not running; show names the readings
+// the committed fit rejected and its model warning.
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -12,6 +13,7 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -19,6 +21,8 @@
 
 #include <gtest/gtest.h>
 
+#include "calibctl/json_value.h"
+#include "src/control/control_response.h"
 #include "src/daemon/control_server.h"
 
 namespace cdpr::integration {
@@ -76,12 +80,28 @@ class OpenDir {
   std::string path, program;
 };
 
+// What the daemon answers to show for a calibration that rejected two
+// readings as gross errors and whose model does not fit.
+std::string show_response() {
+  store::CurrentCalibration current;
+  current.seq = 3;
+  Calibration& c = current.calibration;
+  c.created = "2026-11-22T10:15:00Z";
+  c.robot = "large";
+  c.samples = 35;
+  c.winches.resize(4);
+  c.rejected = {{12, SensorKind::kEncoder, 3, -95.4}, {24, SensorKind::kForce, 0, 8.25}};
+  c.model_warning = "the model does not fit the data: chi-square 912.3 for 614 degrees of freedom";
+  return control::format_show_response(current);
+}
+
 // A control socket answering like the daemon, served on a thread.
 class StubDaemon {
  public:
   explicit StubDaemon(const std::string& socket) {
     auto server = daemon::ControlServer::listen(socket, [](std::string_view line) -> std::string {
       if (line == "status") return std::string(kStatus) + "\n";
+      if (line == "show") return show_response();
       return "{\"ok\":false,\"error\":\"abort ignored: no calibration running\"}\n";
     });
     EXPECT_TRUE(server.ok()) << server.status().to_string();
@@ -146,6 +166,55 @@ TEST(Calibctl, AFailureWithJsonIsStillOneJsonObjectOnStdout) {
   EXPECT_EQ(text.exit_status, 1);
   EXPECT_EQ(text.out, "");
   EXPECT_TRUE(contains(text.err, "abort ignored: no calibration running")) << text.err;
+}
+
+TEST(Calibctl, ShowNamesTheRejectedReadingsAndTheModelWarning) {
+  // GIVEN a daemon whose committed calibration rejected two readings and warns of a misfit
+  OpenDir dir;
+  const std::string socket = dir.path + "/control";
+  StubDaemon daemon(socket);
+  // WHEN an operator asks show
+  const Outcome text = dir.calibctl({"--socket", socket, "show"});
+  // THEN the warning and each rejected reading (row, sensor, cable, residual) are printed after the fit
+  EXPECT_EQ(text.exit_status, 0) << text.err;
+  EXPECT_TRUE(contains(text.out, "\nMODEL WARNING: the model does not fit the data: chi-square 912.3 for 614 "
+                                 "degrees of freedom\n"
+                                 "gross errors (normalised residual at the robust fit; left out of the final fit):\n"
+                                 "  row   12  encoder cable 3     -95.4 sigma\n"
+                                 "  row   24  force                +8.2 sigma\n"))
+      << text.out;
+  // AND a script gets them from --json
+  const Outcome json = dir.calibctl({"--socket", socket, "show", "--json"});
+  EXPECT_EQ(json.exit_status, 0) << json.err;
+  const auto shown = calibctl::JsonValue::parse(json.out);
+  ASSERT_TRUE(shown) << json.out;
+  EXPECT_EQ((*shown)["model_warning"].string().substr(0, 32), "the model does not fit the data:");
+  const auto rejected = (*shown)["rejected"].array();
+  ASSERT_EQ(rejected.size(), 2u) << json.out;
+  EXPECT_EQ(rejected[1]["row"].integer(), 24);
+  EXPECT_EQ(rejected[1]["sensor"].string(), "force");
+  EXPECT_EQ(rejected[1]["cable"].integer(), 0);
+  EXPECT_EQ(rejected[1]["residual"].number(), 8.25);
+}
+
+TEST(Calibctl, AResponseThatIsNotJsonIsRefusedWithoutACrash) {
+  // GIVEN response lines a broken or hostile peer may send
+  for (const std::string& text : std::vector<std::string>{"", "{", "{\"ok\":tru}", "[1,2", "\"\xff\"", "{\"ok\":1e400}",
+                                 std::string(10'000, '['), "{\"ok\":true} trailing"}) {
+    // WHEN parsed THEN refused with a reason, never thrown
+    std::string error;
+    EXPECT_FALSE(calibctl::JsonValue::parse(text, &error)) << text;
+    EXPECT_FALSE(error.empty());
+  }
+  // AND members of the wrong kind read as blanks, not exceptions
+  const auto odd = calibctl::JsonValue::parse(R"({"ok":"yes","seq":1e300,"state":7,"model":{"a":1},"fit":[1]})");
+  ASSERT_TRUE(odd);
+  EXPECT_FALSE((*odd)["ok"].boolean());
+  EXPECT_EQ((*odd)["seq"].integer(), std::numeric_limits<int>::max());
+  EXPECT_EQ((*odd)["state"].string(), "");
+  EXPECT_TRUE((*odd)["model"].array().empty());
+  EXPECT_TRUE((*odd)["fit"]["cost_final"].is_null());
+  EXPECT_TRUE((*odd)["missing"]["deeper"].is_null());
 }
 
 TEST(Calibctl, APermissionErrorNamesTheGroupNotAMissingDaemon) {

@@ -1,173 +1,52 @@
 #include "calibctl/json_value.h"
 
-#include <cstdlib>
+#include <algorithm>
+#include <limits>
+
+#include <nlohmann/json.hpp>
 
 namespace cdpr::calibctl {
 
-class JsonParser {
- public:
-  explicit JsonParser(std::string_view text) : text_(text) {}
+bool JsonValue::is_null() const { return node_ == nullptr || node_->is_null(); }
 
-  bool parse_document(JsonValue& out) {
-    skip_space();
-    if (!parse_value(out, 0)) return false;
-    skip_space();
-    return pos_ == text_.size() || fail("trailing characters");
-  }
-  std::string error() const { return error_ + " at byte " + std::to_string(pos_); }
+bool JsonValue::boolean() const { return node_ != nullptr && node_->is_boolean() && node_->get<bool>(); }
 
- private:
-  static constexpr int kMaxDepth = 32;
+double JsonValue::number(double fallback) const {
+  return node_ != nullptr && node_->is_number() ? node_->get<double>() : fallback;
+}
 
-  bool fail(const char* what) {
-    if (error_.empty()) error_ = what;
-    return false;
-  }
-  void skip_space() {
-    while (pos_ < text_.size() && (text_[pos_] == ' ' || text_[pos_] == '\t' || text_[pos_] == '\n' ||
-                                   text_[pos_] == '\r')) {
-      ++pos_;
-    }
-  }
-  bool literal(std::string_view word) {
-    if (text_.substr(pos_, word.size()) != word) return fail("unknown literal");
-    pos_ += word.size();
-    return true;
-  }
+int JsonValue::integer() const {
+  constexpr double kLowest = std::numeric_limits<int>::lowest();
+  constexpr double kMax = std::numeric_limits<int>::max();
+  return static_cast<int>(std::clamp(number(), kLowest, kMax));
+}
 
-  bool parse_value(JsonValue& out, int depth) {
-    if (depth > kMaxDepth) return fail("nested too deeply");
-    if (pos_ >= text_.size()) return fail("unexpected end");
-    const char c = text_[pos_];
-    if (c == '{') return parse_object(out, depth);
-    if (c == '[') return parse_array(out, depth);
-    if (c == '"') {
-      out.kind_ = JsonValue::Kind::kString;
-      return parse_string(out.string_);
-    }
-    if (c == 't' || c == 'f') {
-      out.kind_ = JsonValue::Kind::kBool;
-      out.bool_ = c == 't';
-      return literal(c == 't' ? "true" : "false");
-    }
-    if (c == 'n') return literal("null");
-    return parse_number(out);
-  }
+std::string JsonValue::string() const {
+  return node_ != nullptr && node_->is_string() ? node_->get<std::string>() : std::string();
+}
 
-  bool parse_number(JsonValue& out) {
-    const std::string copy(text_.substr(pos_, 64));
-    char* end = nullptr;
-    out.number_ = std::strtod(copy.c_str(), &end);
-    if (end == copy.c_str()) return fail("expected a value");
-    out.kind_ = JsonValue::Kind::kNumber;
-    pos_ += static_cast<std::size_t>(end - copy.c_str());
-    return true;
-  }
+std::vector<JsonValue> JsonValue::array() const {
+  std::vector<JsonValue> elements;
+  if (node_ == nullptr || !node_->is_array()) return elements;
+  elements.reserve(node_->size());
+  for (const nlohmann::json& element : *node_) elements.push_back(JsonValue(document_, &element));
+  return elements;
+}
 
-  static void append_utf8(std::string& out, unsigned code) {
-    if (code < 0x80) {
-      out += static_cast<char>(code);
-    } else if (code < 0x800) {
-      out += static_cast<char>(0xC0 | (code >> 6));
-      out += static_cast<char>(0x80 | (code & 0x3F));
-    } else {
-      out += static_cast<char>(0xE0 | (code >> 12));
-      out += static_cast<char>(0x80 | ((code >> 6) & 0x3F));
-      out += static_cast<char>(0x80 | (code & 0x3F));
-    }
-  }
-
-  bool parse_string(std::string& out) {
-    ++pos_;  // opening quote
-    while (pos_ < text_.size()) {
-      const char c = text_[pos_++];
-      if (c == '"') return true;
-      if (c != '\\') {
-        out += c;
-        continue;
-      }
-      if (pos_ >= text_.size()) break;
-      const char e = text_[pos_++];
-      switch (e) {
-        case 'n': out += '\n'; break;
-        case 't': out += '\t'; break;
-        case 'r': out += '\r'; break;
-        case 'b': out += '\b'; break;
-        case 'f': out += '\f'; break;
-        case 'u': {
-          if (pos_ + 4 > text_.size()) return fail("short \\u escape");
-          const std::string hex(text_.substr(pos_, 4));
-          char* end = nullptr;
-          const unsigned long code = std::strtoul(hex.c_str(), &end, 16);
-          if (end != hex.c_str() + 4) return fail("bad \\u escape");
-          append_utf8(out, static_cast<unsigned>(code));
-          pos_ += 4;
-          break;
-        }
-        default: out += e;  // \" \\ \/
-      }
-    }
-    return fail("unterminated string");
-  }
-
-  bool parse_array(JsonValue& out, int depth) {
-    out.kind_ = JsonValue::Kind::kArray;
-    ++pos_;
-    skip_space();
-    if (pos_ < text_.size() && text_[pos_] == ']') return ++pos_, true;
-    for (;;) {
-      skip_space();
-      if (!parse_value(out.array_.emplace_back(), depth + 1)) return false;
-      skip_space();
-      if (pos_ >= text_.size()) return fail("unterminated array");
-      const char c = text_[pos_++];
-      if (c == ']') return true;
-      if (c != ',') return fail("expected ',' or ']'");
-    }
-  }
-
-  bool parse_object(JsonValue& out, int depth) {
-    out.kind_ = JsonValue::Kind::kObject;
-    ++pos_;
-    skip_space();
-    if (pos_ < text_.size() && text_[pos_] == '}') return ++pos_, true;
-    for (;;) {
-      skip_space();
-      if (pos_ >= text_.size() || text_[pos_] != '"') return fail("expected a key");
-      std::string key;
-      if (!parse_string(key)) return false;
-      skip_space();
-      if (pos_ >= text_.size() || text_[pos_++] != ':') return fail("expected ':'");
-      skip_space();
-      if (!parse_value(out.object_[key], depth + 1)) return false;
-      skip_space();
-      if (pos_ >= text_.size()) return fail("unterminated object");
-      const char c = text_[pos_++];
-      if (c == '}') return true;
-      if (c != ',') return fail("expected ',' or '}'");
-    }
-  }
-
-  std::string_view text_;
-  std::size_t pos_ = 0;
-  std::string error_;
-};
-
-const JsonValue& JsonValue::operator[](std::string_view key) const {
-  static const JsonValue kNull;
-  if (kind_ != Kind::kObject) return kNull;
-  const auto it = object_.find(key);
-  return it == object_.end() ? kNull : it->second;
+JsonValue JsonValue::operator[](std::string_view key) const {
+  if (node_ == nullptr || !node_->is_object()) return {};
+  const auto member = node_->find(std::string(key));
+  return member == node_->end() ? JsonValue() : JsonValue(document_, &*member);
 }
 
 std::optional<JsonValue> JsonValue::parse(std::string_view text, std::string* error) {
-  JsonValue value;
-  JsonParser parser(text);
-  if (!parser.parse_document(value)) {
-    if (error) *error = parser.error();
+  auto document = std::make_shared<nlohmann::json>(nlohmann::json::parse(text, nullptr, false));
+  if (document->is_discarded()) {
+    if (error) *error = "not a valid JSON text";
     return std::nullopt;
   }
-  return value;
+  const nlohmann::json* root = document.get();
+  return JsonValue(std::move(document), root);
 }
 
 }  // namespace cdpr::calibctl

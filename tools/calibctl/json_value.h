@@ -1,48 +1,46 @@
 #pragma once
-// A small reader for the control socket's one-line JSON responses
-// (src/control/control_response.h): objects, arrays, strings with escapes,
-// numbers, true/false/null. Enough for calibctl; not a general JSON library
-// (no duplicate-key checks, \u escapes outside the BMP are kept as two
-// surrogate code points encoded separately).
+// A read-only view of the control socket's one-line JSON responses
+// (src/control/control_response.h), parsed by nlohmann-json. Only
+// json_value.cc includes the full nlohmann header.
+//
+// Nothing here throws on what the daemon sends: parsing refuses malformed
+// text, and the accessors return a default for a missing member or the wrong
+// kind, so a response from a newer daemon with a changed field shows a
+// blank, never crashes calibctl.
 
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
+
+#include <nlohmann/json_fwd.hpp>
 
 namespace cdpr::calibctl {
 
 class JsonValue {
  public:
-  enum class Kind { kNull, kBool, kNumber, kString, kArray, kObject };
+  JsonValue() = default;  // null
 
-  Kind kind() const { return kind_; }
-  bool is_null() const { return kind_ == Kind::kNull; }
-
-  // Accessors return a default for the wrong kind, so rendering a response
-  // from a newer daemon with a changed field shows a blank, never crashes.
-  bool boolean() const { return kind_ == Kind::kBool && bool_; }
-  double number(double fallback = 0.0) const { return kind_ == Kind::kNumber ? number_ : fallback; }
-  int integer() const { return static_cast<int>(number()); }
-  const std::string& string() const { return string_; }
-  const std::vector<JsonValue>& array() const { return array_; }
+  bool is_null() const;
+  bool boolean() const;  // false unless true
+  double number(double fallback = 0.0) const;
+  int integer() const;  // number() truncated, clamped to int's range
+  std::string string() const;
+  std::vector<JsonValue> array() const;
   // Member `key` of an object; a null value when absent.
-  const JsonValue& operator[](std::string_view key) const;
+  JsonValue operator[](std::string_view key) const;
 
-  // One JSON text (surrounding white space allowed); the error names the
-  // byte offset.
+  // One JSON text (surrounding white space allowed).
   static std::optional<JsonValue> parse(std::string_view text, std::string* error = nullptr);
 
  private:
-  friend class JsonParser;
-  Kind kind_ = Kind::kNull;
-  bool bool_ = false;
-  double number_ = 0.0;
-  std::string string_;
-  std::vector<JsonValue> array_;
-  std::map<std::string, JsonValue, std::less<>> object_;
+  JsonValue(std::shared_ptr<const nlohmann::json> document, const nlohmann::json* node)
+      : document_(std::move(document)), node_(node) {}
+
+  std::shared_ptr<const nlohmann::json> document_;  // keeps node_ alive
+  const nlohmann::json* node_ = nullptr;             // inside *document_; nullptr: null
 };
 
 }  // namespace cdpr::calibctl

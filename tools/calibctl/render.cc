@@ -17,7 +17,8 @@ void append_if(std::string& out, const char* label, const JsonValue& text) {
 }
 
 double at(const JsonValue& vector, std::size_t k) {
-  return k < vector.array().size() ? vector.array()[k].number() : 0.0;
+  const auto elements = vector.array();
+  return k < elements.size() ? elements[k].number() : 0.0;
 }
 
 }  // namespace
@@ -72,6 +73,18 @@ std::string render_show(const JsonValue& s) {
   out += format("fit: cost %.4g -> %.4g in %d iterations, rms encoder %.4f m, rms force %.3f N\n",
                 fit["cost_initial"].number(), fit["cost_final"].number(), fit["iterations"].integer(),
                 fit["rms_encoder"].number(), fit["rms_force"].number());
+  const std::string warning = s["model_warning"].string();
+  if (!warning.empty()) out += "MODEL WARNING: " + warning + "\n";
+  const auto rejected = s["rejected"].array();
+  if (!rejected.empty()) {
+    out += "gross errors (normalised residual at the robust fit; left out of the final fit):\n";
+    for (const JsonValue& r : rejected) {
+      const std::string sensor = r["sensor"].string();
+      out += format("  row %4d  %-7s", r["row"].integer(), sensor.c_str());
+      out += sensor == "force" ? std::string(8, ' ') : format(" cable %d", r["cable"].integer());
+      out += format("  %+8.1f sigma\n", r["residual"].number());
+    }
+  }
   return out;
 }
 

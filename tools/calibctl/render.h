@@ -13,7 +13,8 @@ namespace cdpr::calibctl {
 std::string render_status(const JsonValue& status);
 // One line for `status --follow`: "[ 12%] settle 3/35 (2 sampled, 0 skipped) platform moving: ...".
 std::string render_progress(const JsonValue& status);
-// The current calibration: one line per winch with anchor, offset and sigmas, then the fit.
+// The current calibration: one line per winch with anchor, offset and sigmas,
+// the fit, then the model warning and the rejected readings when there are any.
 std::string render_show(const JsonValue& show);
 // The stored versions, newest first, the current one marked.
 std::string render_history(const JsonValue& history);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "../calibration/calibration_rig.h"
+#include "../store/store_test_support.h"
 
 namespace cdpr::control {
 namespace {
@@ -71,6 +72,24 @@ TEST(ControlDispatch, ShowHistoryAndRollbackAfterACalibration) {
   EXPECT_EQ(rollback, "{\"ok\":true,\"message\":\"calibration 1 is current\"}\n");
   EXPECT_TRUE(rig.previous_calibration_intact());
   EXPECT_TRUE(contains(ask(rig, "rollback 9"), "rollback to 9 failed: open"));
+}
+
+TEST(ControlDispatch, ShowListsTheRejectedReadingsAndTheModelWarning) {
+  // GIVEN a clean committed calibration WHEN shown THEN no warning and no rejected reading
+  CalibrationRig rig;
+  EXPECT_TRUE(ask(rig, "show").ends_with(",\"model_warning\":\"\",\"rejected\":[]}\n"));
+  // AND GIVEN a committed calibration.toml with two [[rejected]] readings and a model_warning
+  Calibration calibration = store::test::calibration_version(2);
+  calibration.rejected = {{12, SensorKind::kEncoder, 3, -95.4}, {24, SensorKind::kForce, 0, 8.25}};
+  calibration.model_warning = "the model does not fit the data: chi-square 912.3 for 614 degrees of freedom";
+  ASSERT_TRUE(rig.store.commit(calibration));
+  // WHEN shown THEN both follow the fit, each reading with row, sensor, cable and residual in sigmas
+  const std::string show = ask(rig, "show");
+  EXPECT_TRUE(show.ends_with(
+      "\"rms_force\":4.8},\"model_warning\":\"the model does not fit the data: chi-square 912.3 for 614 degrees "
+      "of freedom\",\"rejected\":[{\"row\":12,\"sensor\":\"encoder\",\"cable\":3,\"residual\":-95.4},"
+      "{\"row\":24,\"sensor\":\"force\",\"cable\":0,\"residual\":8.25}]}\n"))
+      << show;
 }
 
 TEST(ControlDispatch, GarbageGetsAnErrorLine) {

@@ -1,34 +1,12 @@
+#include "src/control/line_assembler.h"
+
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
-#include "src/control/json_writer.h"
-#include "src/control/line_assembler.h"
-
 namespace cdpr::control {
 namespace {
-
-TEST(JsonWriter, EscapesQuotesControlBytesAndInvalidUtf8) {
-  // GIVEN text with quotes, backslashes, newlines, a control byte, valid and invalid UTF-8
-  const std::string text = std::string("a\"b\\c\nd\x01") + "\xc3\xa9" + "\xff" + "\xe2\x82";
-  // WHEN written as a JSON string
-  const std::string json = json_string(text);
-  // THEN every special is escaped, valid UTF-8 kept, invalid bytes replaced by U+FFFD
-  EXPECT_EQ(json, "\"a\\\"b\\\\c\\nd\\u0001\xc3\xa9\xef\xbf\xbd\xef\xbf\xbd\xef\xbf\xbd\"");
-  EXPECT_EQ(json.find('\n'), std::string::npos);
-}
-
-TEST(JsonWriter, WritesNestedObjectsWithCommasAndNullForNonFinite) {
-  // GIVEN a nested structure
-  JsonWriter json;
-  json.begin_object().key("ok").value(true).key("n").value(3).key("x").value(0.5);
-  json.key("bad").value(std::numeric_limits<double>::infinity());
-  json.key("list").begin_array().value("a").begin_object().key("k").value(false).end_object().end_array();
-  json.end_object();
-  // WHEN rendered THEN it is the expected one-line JSON
-  EXPECT_EQ(json.text(), R"({"ok":true,"n":3,"x":0.5,"bad":null,"list":["a",{"k":false}]})");
-}
 
 struct Collected {
   std::vector<std::string> lines;
