@@ -74,11 +74,14 @@ fuzz: deps
 	./tests/fuzz/run_fuzzers.sh $(FUZZ_BUILD) $(FUZZ_SECONDS) $(subst $(comma), ,$(FUZZ_TARGETS))
 
 # The daemon against the virtual robot over real sockets, button via calibctl.
-demo: all
+# Builds those three programs only.
+demo: configure
+	cmake --build $(BUILD) -j $(JOBS) --target cdpr-calibd virtual-robot calibctl
 	./tools/demo.sh $(BUILD)
 
 # The offline pipeline only: cdpr-sim, cdpr-calib solve, compare with truth.
-demo-offline: all
+demo-offline: configure
+	cmake --build $(BUILD) -j $(JOBS) --target cdpr-sim cdpr-calib
 	./tools/demo-offline.sh $(BUILD)
 
 bench: bench-deps configure
