@@ -1,6 +1,6 @@
-# Front door. `make test` and `make demo` work on a fresh Debian 12 as root:
-# they install the Debian packages that are missing (and only those), configure
-# CMake once, build with -Wall -Wextra -Werror and run.
+# Front door. `make check`, `make test` and `make demo` work on a fresh Debian
+# 12 as root: they install the Debian packages that are missing (and only
+# those), configure CMake once, build with -Wall -Wextra -Werror and run.
 
 BUILD      ?= build
 BUILD_TYPE ?= RelWithDebInfo
@@ -26,7 +26,7 @@ FUZZ_BUILD   ?= $(BUILD)-fuzz
 FUZZ_SECONDS ?= 600
 FUZZ_TARGETS ?=
 
-.PHONY: all deps bench-deps configure test sanitize fuzz demo demo-offline bench install deb clean
+.PHONY: all deps bench-deps configure check test sanitize fuzz demo demo-offline bench install deb clean
 
 all: configure
 	cmake --build $(BUILD) -j $(JOBS)
@@ -42,6 +42,13 @@ $(BUILD)/CMakeCache.txt:
 
 configure: deps $(BUILD)/CMakeCache.txt
 
+# The day-to-day loop: builds what the unit tests run, runs the tests
+# labelled unit (cmake/CdprTesting.cmake), seconds after the build.
+check: configure
+	cmake --build $(BUILD) -j $(JOBS) --target unit_test_binaries
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -L '^unit$$'
+
+# Every test: unit, integration and slow.
 test: all
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
@@ -67,11 +74,14 @@ fuzz: deps
 	./tests/fuzz/run_fuzzers.sh $(FUZZ_BUILD) $(FUZZ_SECONDS) $(subst $(comma), ,$(FUZZ_TARGETS))
 
 # The daemon against the virtual robot over real sockets, button via calibctl.
-demo: all
+# Builds those three programs only.
+demo: configure
+	cmake --build $(BUILD) -j $(JOBS) --target cdpr-calibd virtual-robot calibctl
 	./tools/demo.sh $(BUILD)
 
 # The offline pipeline only: cdpr-sim, cdpr-calib solve, compare with truth.
-demo-offline: all
+demo-offline: configure
+	cmake --build $(BUILD) -j $(JOBS) --target cdpr-sim cdpr-calib
 	./tools/demo-offline.sh $(BUILD)
 
 bench: bench-deps configure
