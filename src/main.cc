@@ -30,11 +30,9 @@
 #include "drivers/button/gpio_button.h"
 #endif
 #include "src/daemon/daemon_config.h"
-#include "src/load_cell_driver_config.h"
 #include "src/daemon/daemon_loop.h"
 #include "src/daemon/instance_lock.h"
 #include "src/formats/robot_toml.h"
-#include "src/winch_bank_config.h"
 #include "version/version.h"
 
 namespace {
@@ -112,8 +110,8 @@ int main(int argc, char** argv) {
     log_line("configuration: " + problem->message());
     return 1;
   }
-  const drivers::can::CanWinchBankConfig winch_config = winch_bank_config(config->winches);
-  const drivers::modbus::ModbusLoadCellConfig cell_config = daemon::load_cell_driver_config(config->load_cell);
+  const drivers::can::CanWinchBankConfig& winch_config = config->winches;
+  const drivers::modbus::ModbusLoadCellConfig& cell_config = config->load_cell;
   for (const std::string& problem : {drivers::can::validate(winch_config), drivers::modbus::validate(cell_config)}) {
     if (!problem.empty()) {
       log_line("configuration " + config_path + ": " + problem);

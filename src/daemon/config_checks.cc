@@ -117,6 +117,28 @@ std::optional<FormatError> check_limits(const DaemonConfig& c) {
   return std::nullopt;
 }
 
+// The unit identifiers a transport takes: on a serial line 0 is broadcast
+// (nobody answers) and 248-255 are reserved; a Modbus TCP device addressed
+// directly takes 0 or 255 (libmodbus 3.1 refuses 248-254).
+std::optional<FormatError> check_load_cell(const DaemonConfig& c) {
+  const LoadCellConfig& cell = c.load_cell;
+  const std::string got = ", got " + std::to_string(cell.slave_id);
+  if (cell.endpoint.starts_with("rtu:") && (cell.slave_id < 1 || cell.slave_id > 247)) {
+    return problem(c, "load_cell.slave_id", "must be in 1..247 on a serial line (0 is broadcast)" + got);
+  }
+  if (!cell.endpoint.starts_with("rtu:") && cell.slave_id > 247 && cell.slave_id < 255) {
+    return problem(c, "load_cell.slave_id", "on TCP must be 0..247 or 255" + got);
+  }
+  const drivers::modbus::LoadCellMap& m = cell.map;
+  if (m.status_address >= 0 && m.status_address >= m.value_address &&
+      m.status_address < m.value_address + drivers::modbus::value_register_count(m.value_type)) {
+    return problem(c, "load_cell.status_address",
+                   std::to_string(m.status_address) + " overlaps the value's registers (from load_cell.value_address " +
+                       std::to_string(m.value_address) + ")");
+  }
+  return std::nullopt;
+}
+
 std::optional<FormatError> check_counts_and_times(const DaemonConfig& c) {
   const calibration::CalibratorOptions& o = c.calibrator;
   if (o.validation.min_samples > o.planner.waypoint_count) {
@@ -136,6 +158,13 @@ std::optional<FormatError> check_counts_and_times(const DaemonConfig& c) {
                        significant(1e-6 * static_cast<double>(o.equilibrium.window_us)) +
                        " s): every waypoint would be skipped");
   }
+  // The drives watch the daemon's heartbeat: a window no longer than its
+  // period stops them between two heartbeats.
+  if (auto p = ordered(c, "winches.master_heartbeat_ms", 1e-3 * static_cast<double>(c.winches.master_heartbeat_us),
+                       "winches.drive.consumer_heartbeat_ms",
+                       1e-3 * static_cast<double>(c.winches.drive.consumer_heartbeat_us), "ms")) {
+    return p;
+  }
   if (o.monitor.pose_stale_us <= c.loop_period_us) {
     return problem(c, "limits.pose_stale_ms",
                    "must be longer than loop.period_ms (" +
@@ -148,6 +177,7 @@ std::optional<FormatError> check_counts_and_times(const DaemonConfig& c) {
 
 std::optional<FormatError> check_cross_keys(const DaemonConfig& config) {
   if (auto p = check_endpoints(config)) return p;
+  if (auto p = check_load_cell(config)) return p;
   if (auto p = check_limits(config)) return p;
   return check_counts_and_times(config);
 }

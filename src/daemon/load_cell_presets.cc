@@ -3,24 +3,37 @@
 namespace cdpr::daemon {
 namespace {
 
+using drivers::modbus::ByteOrder;
+using drivers::modbus::ForceUnit;
+using drivers::modbus::LoadCellMap;
+using drivers::modbus::ValueType;
+
 // The map this daemon always read (and the virtual robot's default):
 // float32 newtons at 0-1, status at 2 with bit 0 stable and bit 1 error.
-LoadCellMapConfig legacy_float32() { return LoadCellMapConfig{}; }
+LoadCellMap legacy_float32() {
+  LoadCellMap m;
+  m.value_address = 0;
+  m.value_type = ValueType::kFloat32;
+  m.byte_order = ByteOrder::kABCD;
+  m.unit = ForceUnit::kNewton;
+  m.status_address = 2;
+  m.stable = {0x0001, true};
+  m.error = {0x0002, true};
+  return m;
+}
 
 // Flintec FT-11 indicator, Modbus RTU appendix: the displayed weight as a
 // 32-bit integer at 40001-40002 (high word first), status at 40003 with
 // D1 "data ok" (0: error, code in D13-D15) and D2 "motion" (1: not stable).
 // The decimal point and unit are the indicator's settings (kg by default).
-LoadCellMapConfig flintec_ft11() {
-  LoadCellMapConfig m;
+LoadCellMap flintec_ft11() {
+  LoadCellMap m;
   m.value_address = 0;
-  m.value_type = "int32";
-  m.unit = "kg";
+  m.value_type = ValueType::kInt32;
+  m.unit = ForceUnit::kKilogram;
   m.status_address = 2;
-  m.stable_mask = 0x0004;
-  m.stable_when_set = false;
-  m.error_mask = 0x0002;
-  m.error_when_set = false;
+  m.stable = {0x0004, false};
+  m.error = {0x0002, false};
   return m;
 }
 
@@ -30,16 +43,14 @@ LoadCellMapConfig flintec_ft11() {
 // malfunction, maximum weight exceeded by 9 divisions, gross above 110 % of
 // full scale, gross beyond +-999999) make the reading unusable; bit 11 is
 // "weight stability".
-LoadCellMapConfig laumas_tlu() {
-  LoadCellMapConfig m;
+LoadCellMap laumas_tlu() {
+  LoadCellMap m;
   m.value_address = 7;
-  m.value_type = "uint32";
-  m.unit = "kg";
+  m.value_type = ValueType::kUint32;
+  m.unit = ForceUnit::kKilogram;
   m.status_address = 6;
-  m.stable_mask = 0x0800;
-  m.stable_when_set = true;
-  m.error_mask = 0x001F;
-  m.error_when_set = true;
+  m.stable = {0x0800, true};
+  m.error = {0x001F, true};
   m.sign_mask = 0x0080;
   return m;
 }
@@ -51,7 +62,7 @@ const std::vector<std::string_view>& load_cell_preset_names() {
   return names;
 }
 
-std::optional<LoadCellMapConfig> load_cell_preset(std::string_view name) {
+std::optional<LoadCellMap> load_cell_preset(std::string_view name) {
   if (name == "legacy-float32") return legacy_float32();
   if (name == "flintec-ft-11") return flintec_ft11();
   if (name == "laumas-tlu") return laumas_tlu();

@@ -23,7 +23,6 @@
 #include "drivers/clock/monotonic_clock.h"
 #include "drivers/modbus/modbus_load_cell.h"
 #include "src/daemon/load_cell_presets.h"
-#include "src/load_cell_driver_config.h"
 #include "virtual-robot/modbus_rtu_server.h"
 #include "virtual-robot/modbus_tcp_server.h"
 
@@ -88,15 +87,14 @@ modbus_t* client_for(const std::string& endpoint, int unit) {
 }
 
 drivers::modbus::ModbusLoadCellConfig driver_config(const std::string& endpoint, LoadCellModel model, int unit) {
-  daemon::LoadCellConfig c;
+  drivers::modbus::ModbusLoadCellConfig c;
   c.endpoint = endpoint;
   c.slave_id = unit;
-  c.preset = to_string(model);
-  c.map = *daemon::load_cell_preset(c.preset);
+  c.map = *daemon::load_cell_preset(to_string(model));
   if (model != LoadCellModel::kLegacyFloat32) c.map.decimals = kShownDecimals;
   c.response_timeout_us = 100'000;
   c.retries = 0;
-  return daemon::load_cell_driver_config(c);
+  return c;
 }
 
 class EachTransport : public ::testing::TestWithParam<bool> {};

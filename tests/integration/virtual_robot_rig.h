@@ -27,8 +27,6 @@
 #include "src/calibration/waypoint_planner.h"
 #include "src/daemon/daemon_loop.h"
 #include "src/daemon/load_cell_presets.h"
-#include "src/load_cell_driver_config.h"
-#include "src/winch_bank_config.h"
 #include "virtual-robot/virtual_robot.h"
 
 namespace cdpr::integration {
@@ -176,9 +174,8 @@ class VirtualRobotRig {
     EXPECT_TRUE(store->open());
     if (before_start) before_start(*this);
     winches = std::make_unique<drivers::can::CanopenWinchBank>(
-        winch_bank_config(config.winches), drivers::can::make_can_connector(config.winches.endpoint));
-    load_cell = std::make_unique<drivers::modbus::ModbusLoadCell>(daemon::load_cell_driver_config(config.load_cell),
-                                                                  clock);
+        config.winches, drivers::can::make_can_connector(config.winches.endpoint));
+    load_cell = std::make_unique<drivers::modbus::ModbusLoadCell>(config.load_cell, clock);
     load_cell_reader = std::make_unique<drivers::LoadCellReader>(
         *load_cell, clock,
         drivers::LoadCellReaderOptions{config.load_cell.poll_interval_us, config.load_cell.fault_timeout_us,

@@ -36,7 +36,7 @@ TEST(DaemonConfig, TheShippedExampleParsesToTheDefaults) {
   EXPECT_EQ(config->winches.master_node_id, defaults.winches.master_node_id);
   EXPECT_EQ(config->winches.master_heartbeat_us, defaults.winches.master_heartbeat_us);
   EXPECT_EQ(config->winches.sdo_timeout_us, defaults.winches.sdo_timeout_us);
-  const CanDriveDescription& drive = config->winches.drive;
+  const drivers::can::DriveDescription& drive = config->winches.drive;
   EXPECT_EQ(drive.quick_stop_option, defaults.winches.drive.quick_stop_option);
   EXPECT_EQ(drive.abort_connection_option, defaults.winches.drive.abort_connection_option);
   EXPECT_EQ(drive.profile_velocity_mps, defaults.winches.drive.profile_velocity_mps);
@@ -112,12 +112,12 @@ accept_max_iterations = true
   EXPECT_EQ(config->load_cell.parity, 'E');
   // the preset's map, with the keys beside it overriding
   EXPECT_EQ(config->load_cell.preset, "flintec-ft-11");
-  EXPECT_EQ(config->load_cell.map.value_type, "int32");
-  EXPECT_EQ(config->load_cell.map.byte_order, "CDAB");
+  EXPECT_EQ(config->load_cell.map.value_type, drivers::modbus::ValueType::kInt32);
+  EXPECT_EQ(config->load_cell.map.byte_order, drivers::modbus::ByteOrder::kCDAB);
   EXPECT_EQ(config->load_cell.map.decimals, 1);
-  EXPECT_EQ(config->load_cell.map.unit, "kg");
-  EXPECT_EQ(config->load_cell.map.error_mask, 0x0002);
-  EXPECT_FALSE(config->load_cell.map.error_when_set);
+  EXPECT_EQ(config->load_cell.map.unit, drivers::modbus::ForceUnit::kKilogram);
+  EXPECT_EQ(config->load_cell.map.error.mask, 0x0002);
+  EXPECT_FALSE(config->load_cell.map.error.active_when_set);
   EXPECT_EQ(config->load_cell.fault_timeout_us, 400'000);
   EXPECT_FALSE(config->button.gpio);
   EXPECT_EQ(config->calibrator.equilibrium.window_us, 1'500'000);
