@@ -19,8 +19,8 @@
 #include <vector>
 
 #include "hal/clock.h"
-#include "solver/calibrate.h"
-#include "solver/robot.h"
+#include "solver/calibration/calibrate.h"
+#include "solver/model/robot.h"
 #include "src/calibration/calibration_state_machine.h"
 #include "src/daemon/load_cell_presets.h"
 #include "src/formats/expected.h"

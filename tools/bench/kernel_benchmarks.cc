@@ -9,11 +9,11 @@
 #include <benchmark/benchmark.h>
 
 #include "bench_problems.h"
-#include "solver/keys.h"
-#include "solver/normal_equations.h"
-#include "solver/schur_complement.h"
-#include "solver/sparse_cholesky.h"
-#include "solver/static_pose_factor.h"
+#include "solver/nls/keys.h"
+#include "solver/nls/normal_equations.h"
+#include "solver/nls/schur_complement.h"
+#include "solver/linalg/sparse_cholesky.h"
+#include "solver/calibration/static_pose_factor.h"
 
 namespace cdpr::bench {
 namespace {

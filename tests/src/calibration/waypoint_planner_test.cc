@@ -5,9 +5,9 @@
 
 #include <gtest/gtest.h>
 
-#include "../../solver/test_robots.h"
-#include "solver/cable_prediction.h"
-#include "solver/pose_design.h"
+#include "../../solver/model/test_robots.h"
+#include "solver/model/cable_prediction.h"
+#include "solver/calibration/pose_design.h"
 
 namespace cdpr::calibration {
 namespace {
