@@ -5,14 +5,10 @@
 
 #include <span>
 
+#include "solver/linalg/row_range.h"
 #include "solver/nls/keys.h"
 
 namespace cdpr {
-
-// Rows [first, end) of a factor's residual vector.
-struct RowRange {
-  int first = 0, end = 0;
-};
 
 class Factor {
  public:

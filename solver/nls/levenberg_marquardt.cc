@@ -6,9 +6,10 @@
 #include <cstdlib>
 #include <limits>
 
-#include "solver/nls/normal_equations.h"
-#include "solver/nls/schur_complement.h"
+#include "solver/linalg/normal_equations.h"
+#include "solver/linalg/schur_complement.h"
 #include "solver/linalg/sparse_cholesky.h"
+#include "solver/nls/linearization.h"
 
 namespace cdpr {
 namespace {
@@ -55,8 +56,9 @@ class LinearSystem {
 // The whole J^T J in CHOLMOD, AMD-ordered: any problem.
 class FullSystem final : public LinearSystem {
  public:
-  explicit FullSystem(const Problem& problem)
-      : equations_(problem),
+  FullSystem(std::unique_ptr<Linearization> linearization, const EliminationOrder& order)
+      : linearization_(std::move(linearization)),
+        equations_(linearization_->jacobian(), order),
         jtj_(equations_.nonzeros()),
         damped_(equations_.nonzeros()) {
     if (equations_.columns() > 0) {
@@ -68,7 +70,7 @@ class FullSystem final : public LinearSystem {
   int columns() const override { return equations_.columns(); }
   int variable_column(int v) const override { return equations_.variable_column(v); }
   bool evaluate(const double* state, int slot, double* cost, int* failed_factor) override {
-    return equations_.evaluate(state, slot, cost, failed_factor);
+    return linearization_->evaluate(state, slot, cost, failed_factor);
   }
   void accumulate(int slot, double* gradient) override { equations_.accumulate(slot, jtj_.data(), gradient); }
   FactorizationStatus factorize(double radius, std::string* message) override {
@@ -89,21 +91,23 @@ class FullSystem final : public LinearSystem {
   }
 
  private:
+  std::unique_ptr<Linearization> linearization_;
   NormalEquations equations_;
   std::unique_ptr<SparseCholesky> cholesky_;
   std::vector<double> jtj_, damped_;
 };
 
 // Per-pose blocks eliminated first, dense Cholesky of the reduced system over the
-// global variables (solver/nls/schur_complement.h): calibration problems.
+// global variables (solver/linalg/schur_complement.h): calibration problems.
 class ReducedSystem final : public LinearSystem {
  public:
-  explicit ReducedSystem(std::unique_ptr<SchurComplement> schur) : schur_(std::move(schur)) {}
+  ReducedSystem(std::unique_ptr<Linearization> linearization, std::unique_ptr<SchurComplement> schur)
+      : linearization_(std::move(linearization)), schur_(std::move(schur)) {}
   LinearSystemKind kind() const override { return LinearSystemKind::kPosesEliminated; }
   int columns() const override { return schur_->columns(); }
   int variable_column(int v) const override { return schur_->variable_column(v); }
   bool evaluate(const double* state, int slot, double* cost, int* failed_factor) override {
-    return schur_->linearization().evaluate(state, slot, cost, failed_factor);
+    return linearization_->evaluate(state, slot, cost, failed_factor);
   }
   void accumulate(int slot, double* gradient) override { schur_->accumulate(slot, gradient); }
   FactorizationStatus factorize(double radius, std::string* message) override {
@@ -115,16 +119,21 @@ class ReducedSystem final : public LinearSystem {
   }
 
  private:
+  std::unique_ptr<Linearization> linearization_;  // read by schur_
   std::unique_ptr<SchurComplement> schur_;
 };
 
-// The system for a problem: reduced when its structure allows, else the
-// whole J^T J (with no columns when every variable is constant).
+// The system for a problem: reduced when its structure allows (the
+// elimination order the problem gives), else the whole J^T J (with no
+// columns when every variable is constant).
 std::unique_ptr<LinearSystem> make_system(const Problem& problem, bool eliminate_poses) {
-  if (std::unique_ptr<SchurComplement> schur = eliminate_poses ? SchurComplement::create(problem) : nullptr) {
-    return std::make_unique<ReducedSystem>(std::move(schur));
+  auto linearization = std::make_unique<Linearization>(problem);
+  const EliminationOrder order = problem.elimination_order();
+  if (std::unique_ptr<SchurComplement> schur =
+          eliminate_poses ? SchurComplement::create(linearization->jacobian(), order) : nullptr) {
+    return std::make_unique<ReducedSystem>(std::move(linearization), std::move(schur));
   }
-  return std::make_unique<FullSystem>(problem);
+  return std::make_unique<FullSystem>(std::move(linearization), order);
 }
 
 }  // namespace

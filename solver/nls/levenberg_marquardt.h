@@ -82,7 +82,7 @@ class SparseCholesky;
 
 enum class LinearSystemKind {
   kFull,             // the whole J^T J in CHOLMOD (AMD order)
-  kPosesEliminated,  // per-pose blocks eliminated, dense Cholesky on the global variables (solver/nls/schur_complement.h)
+  kPosesEliminated,  // per-pose blocks eliminated, dense Cholesky on the global variables (solver/linalg/schur_complement.h)
 };
 
 class LevenbergMarquardt {

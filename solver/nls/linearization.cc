@@ -5,95 +5,70 @@
 #include "solver/linalg/dense_kernels.h"
 
 namespace cdpr {
+namespace {
 
-Linearization::Linearization(const Problem& problem, std::vector<int> variable_column)
-    : problem_(problem), variable_column_(std::move(variable_column)) {
+BlockJacobian empty_jacobian(const Problem& problem) {
+  std::vector<int> dims;
+  std::vector<bool> constant;
+  for (const Problem::Variable& v : problem.variables()) {
+    dims.push_back(v.tangent_dim);
+    constant.push_back(v.constant);
+  }
+  return BlockJacobian(std::move(dims), std::move(constant));
+}
+
+}  // namespace
+
+Linearization::Linearization(const Problem& problem) : problem_(problem), jacobian_(empty_jacobian(problem)) {
   const auto& variables = problem.variables();
-  const auto& factors = problem.factors();
-  layout_.reserve(factors.size());
-  int residual_total = 0, jacobian_total = 0;
-  std::vector<int> jacobian_offset;  // per factor key into a slot's Jacobians, -1 if constant
-  for (const auto& factor : factors) {
+  std::vector<int> key_variables;
+  std::vector<RowRange> key_rows;
+  for (const auto& factor : problem.factors()) {
     const std::span<const Key> keys = factor->keys();
-    const int m = factor->residual_dim();
-    FactorLayout f;
-    f.residual_offset = residual_total;
-    f.key_offset = static_cast<int>(key_variable_.size());
-    f.residual_dim = m;
-    f.key_count = static_cast<int>(keys.size());
-    f.jacobian_offset = jacobian_total;
+    key_variables.clear();
+    key_rows.clear();
     for (std::size_t k = 0; k < keys.size(); ++k) {
       const int v = problem.variable_index(keys[k]);
-      key_variable_.push_back(v);
-      key_column_.push_back(variable_column_[v]);
-      key_dim_.push_back(variables[v].tangent_dim);
-      key_rows_.push_back(factor->jacobian_rows(static_cast<int>(k)));
-      jacobian_offset.push_back(variable_column_[v] >= 0 ? jacobian_total : -1);
-      if (variable_column_[v] >= 0) jacobian_total += m * variables[v].tangent_dim;
+      key_variables.push_back(v);
+      key_rows.push_back(factor->jacobian_rows(static_cast<int>(k)));
+      key_ambient_offset_.push_back(variables[v].ambient_offset);
     }
-    f.jacobian_size = jacobian_total - f.jacobian_offset;
-    layout_.push_back(f);
-    residual_total += m;
+    jacobian_.add_factor(factor->residual_dim(), key_variables, key_rows);
   }
-  parameters_.assign(key_variable_.size(), nullptr);
-  for (int s = 0; s < kSlots; ++s) {
-    residuals_[s].assign(residual_total, 0.0);
-    jacobians_[s].assign(jacobian_total, 0.0);
-    jacobian_pointers_[s].assign(key_variable_.size(), nullptr);
-    for (std::size_t k = 0; k < key_variable_.size(); ++k) {
-      if (jacobian_offset[k] >= 0) jacobian_pointers_[s][k] = jacobians_[s].data() + jacobian_offset[k];
-    }
-  }
+  jacobian_.allocate();
+  parameters_.assign(key_ambient_offset_.size(), nullptr);
 }
 
 bool Linearization::evaluate(const double* state, int slot, double* cost, int* failed_factor) {
-  const auto& variables = problem_.variables();
   const auto& factors = problem_.factors();
-  for (std::size_t k = 0; k < key_variable_.size(); ++k) {
-    parameters_[k] = state + variables[key_variable_[k]].ambient_offset;
-  }
+  for (std::size_t k = 0; k < key_ambient_offset_.size(); ++k) parameters_[k] = state + key_ambient_offset_[k];
   double total = 0.0;
   for (std::size_t fi = 0; fi < factors.size(); ++fi) {
-    const FactorLayout& f = layout_[fi];
-    double* residual = residuals_[slot].data() + f.residual_offset;
-    double* const* jacobians = jacobian_pointers_[slot].data() + f.key_offset;
+    const int f = static_cast<int>(fi);
     double factor_cost = 0.0;
-    if (!factors[fi]->evaluate(parameters_.data() + f.key_offset, residual, jacobians, &factor_cost) ||
+    if (!factors[fi]->evaluate(parameters_.data() + jacobian_.key_offset(f), jacobian_.residuals(slot, f),
+                               jacobian_.jacobian_blocks(slot, f), &factor_cost) ||
         !std::isfinite(factor_cost)) {
-      *failed_factor = static_cast<int>(fi);
+      *failed_factor = f;
       return false;
     }
     total += factor_cost;
   }
   // Every value at once (one pass over two buffers, cheaper than one call
   // per block); only when something is not finite, which factor it was.
-  if (!all_finite(residuals_[slot].data(), residuals_[slot].size()) ||
-      !all_finite(jacobians_[slot].data(), jacobians_[slot].size())) {
-    for (std::size_t fi = 0; fi < factors.size(); ++fi) {
-      const FactorLayout& f = layout_[fi];
-      if (!all_finite(residuals_[slot].data() + f.residual_offset, f.residual_dim) ||
-          !all_finite(jacobians_[slot].data() + f.jacobian_offset, f.jacobian_size)) {
-        *failed_factor = static_cast<int>(fi);
+  const BlockJacobian& j = jacobian_;
+  if (!all_finite(j.residual_values(slot).data(), j.residual_values(slot).size()) ||
+      !all_finite(j.jacobian_values(slot).data(), j.jacobian_values(slot).size())) {
+    for (int f = 0; f < j.factor_count(); ++f) {
+      if (!all_finite(j.residual_values(slot, f).data(), j.residual_values(slot, f).size()) ||
+          !all_finite(j.jacobian_values(slot, f).data(), j.jacobian_values(slot, f).size())) {
+        *failed_factor = f;
         return false;
       }
     }
   }
   *cost = total;
   return true;
-}
-
-void Linearization::add_gradient(int slot, int f, double* gradient) const {
-  const int m = residual_dim(f);
-  const double* residual = residuals(slot, f);
-  for (int k = 0; k < key_count(f); ++k) {
-    const int column = key_column(f, k);
-    if (column < 0) continue;
-    const int d = key_dim(f, k);
-    const double* J = jacobian(slot, f, k);
-    for (int i = 0; i < m; ++i) {
-      for (int c = 0; c < d; ++c) gradient[column + c] += J[i * d + c] * residual[i];
-    }
-  }
 }
 
 }  // namespace cdpr

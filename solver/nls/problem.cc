@@ -134,20 +134,44 @@ void Problem::retract(int v, const double* step) { retract(v, step, state_.data(
 
 void Problem::retract(int v, const double* step, double* state) const {
   const Variable& var = variables_[v];
-  double* a = state + var.ambient_offset;
-  if (!var.is_pose) {
-    for (int i = 0; i < var.ambient_dim; ++i) a[i] += step[i];
+  retract_ambient(var.is_pose, var.ambient_dim, step, state + var.ambient_offset);
+}
+
+EliminationOrder Problem::elimination_order() const {
+  const int nv = static_cast<int>(variables_.size());
+  EliminationOrder order;
+  order.group.assign(nv, EliminationOrder::kKept);
+  std::map<int, int> group_of_pose;
+  for (int v = 0; v < nv; ++v) {
+    const Variable& var = variables_[v];
+    if (var.constant) continue;
+    if (var.key.kind != VariableKind::kPose && var.key.kind != VariableKind::kReferenceForce) {
+      order.kept.push_back(v);
+      continue;
+    }
+    const auto [it, inserted] = group_of_pose.emplace(var.key.index, order.group_count);
+    if (inserted) ++order.group_count;
+    order.group[v] = it->second;
+  }
+  std::stable_sort(order.kept.begin(), order.kept.end(),
+                   [&](int a, int b) { return variables_[a].key < variables_[b].key; });
+  return order;
+}
+
+void retract_ambient(bool is_pose, int ambient_dim, const double* step, double* ambient) {
+  if (!is_pose) {
+    for (int i = 0; i < ambient_dim; ++i) ambient[i] += step[i];
     return;
   }
-  Pose p = pose_from_parameters(a);
-  cdpr::retract(p, step);
-  a[0] = p.position_world.x();
-  a[1] = p.position_world.y();
-  a[2] = p.position_world.z();
-  a[3] = p.world_R_platform.w();
-  a[4] = p.world_R_platform.x();
-  a[5] = p.world_R_platform.y();
-  a[6] = p.world_R_platform.z();
+  Pose p = pose_from_parameters(ambient);
+  retract(p, step);
+  ambient[0] = p.position_world.x();
+  ambient[1] = p.position_world.y();
+  ambient[2] = p.position_world.z();
+  ambient[3] = p.world_R_platform.w();
+  ambient[4] = p.world_R_platform.x();
+  ambient[5] = p.world_R_platform.y();
+  ambient[6] = p.world_R_platform.z();
 }
 
 }  // namespace cdpr

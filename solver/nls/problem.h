@@ -13,11 +13,17 @@
 
 #include <Eigen/Core>
 
+#include "solver/linalg/elimination_order.h"
 #include "solver/nls/factor.h"
 #include "solver/nls/keys.h"
 #include "solver/nls/pose.h"
 
 namespace cdpr {
+
+// The retraction the solver applies (Problem::retract) on one variable's
+// ambient storage: a pose (7 values, x y z qw qx qy qz) by pose.h's retract,
+// a vector by adding the step.
+void retract_ambient(bool is_pose, int ambient_dim, const double* step, double* ambient);
 
 class Problem {
  public:
@@ -53,6 +59,14 @@ class Problem {
   // The same on another flat state of this problem's layout (the solver's
   // candidate copy); allocates nothing.
   void retract(int v, const double* step, double* state) const;
+
+  // Which variables the linear systems eliminate first: the variables of
+  // one static pose (PoseKey(k), ReferenceForceKey(k)), which no factor
+  // shares with another pose, form a group (groups in order of first
+  // appearance); the others are kept, by key, so the variables of one kind
+  // sit side by side (all anchors, then all offsets, ...). Constant
+  // variables take no part.
+  EliminationOrder elimination_order() const;
 
  private:
   void add_variable(Key key, int tangent_dim, int ambient_dim, bool is_pose, const double* value);

@@ -1,5 +1,5 @@
 // LevenbergMarquardt with the per-pose blocks eliminated (Schur complement,
-// solver/nls/schur_complement.h) against the whole J^T J: same iterations, same
+// solver/linalg/schur_complement.h) against the whole J^T J: same iterations, same
 // solution, same covariance; and when the elimination is (not) chosen.
 #include <algorithm>
 #include <cmath>

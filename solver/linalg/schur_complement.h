@@ -1,52 +1,54 @@
 #pragma once
-// The normal equations of a Problem whose per-pose variables can be
-// eliminated first (Ceres' SPARSE_SCHUR in spirit): the variables of each
-// static pose k (PoseKey(k), ReferenceForceKey(k)) form a small "local"
-// group that no factor shares with another pose; everything else (anchors,
-// offsets, model terms) is "global". Then
+// The normal equations of a block-sparse Jacobian whose variables can be
+// eliminated group by group (Ceres' SPARSE_SCHUR in spirit): the
+// elimination order (elimination_order.h) puts variables into small "local"
+// groups that no factor shares with another group (in a calibration: the
+// variables of one static pose); everything else (anchors, offsets, model
+// terms) is "global". Then
 //
 //   [ A   B ] [x_l]   [b_l]        S = C - B' A^-1 B   (reduced matrix)
 //   [ B'  C ] [x_g] = [b_g],       S x_g = b_g - B' A^-1 b_l,
 //                                   x_l = A^-1 (b_l - B x_g),
 //
-// with A block diagonal (one dense block per pose, Cholesky in place) and S
+// with A block diagonal (one dense block per group, Cholesky in place) and S
 // over the global variables only (at most kMaxGlobalDim of them), dense and
 // factorised in place by a dense Cholesky: every pose couples all the
 // globals it reaches, so S has (nearly) no zeros to exploit, and at 16 to
 // 128 columns a sparse factorisation costs more in overhead than in
-// arithmetic. An iteration costs O(poses) small dense operations plus one
-// factorisation of S, whatever the number of poses.
+// arithmetic. An iteration costs O(groups) small dense operations plus one
+// factorisation of S, whatever the number of groups.
 //
 // Everything is sized in the constructor, in time linear in the number of
-// factor keys; evaluate(), accumulate(), factorize() and solve() allocate
-// nothing. The problem's structure must not change while this object lives.
+// factor keys; accumulate(), factorize() and solve() allocate nothing. The
+// Jacobian must outlive this object and keep its structure.
 
 #include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "solver/nls/linearization.h"
-#include "solver/nls/problem.h"
+#include "solver/linalg/block_jacobian.h"
+#include "solver/linalg/elimination_order.h"
 #include "solver/linalg/sparse_cholesky.h"
 
 namespace cdpr {
 
 class SchurComplement {
  public:
-  // Null when the problem lacks the structure: no per-pose or no global
-  // variable, a factor touching two poses' variables, a pose group larger
-  // than kMaxGroupDim or more than kMaxGlobalDim global dimensions (then the
+  // Null when the Jacobian lacks the structure: no group or no global
+  // variable, a factor touching two groups' variables, a group larger than
+  // kMaxGroupDim or more than kMaxGlobalDim global dimensions (then the
   // whole J^T J in CHOLMOD is the better system to factorise: the dense S
-  // grows as the cube of its columns).
+  // grows as the cube of its columns). Otherwise assigns the Jacobian's
+  // columns: each group's variables together (in variable order), then the
+  // kept ones in the order's `kept` order.
   static constexpr int kMaxGroupDim = 16;
   static constexpr int kMaxGlobalDim = 128;
-  static std::unique_ptr<SchurComplement> create(const Problem& problem);
+  static std::unique_ptr<SchurComplement> create(BlockJacobian& jacobian, const EliminationOrder& order);
   ~SchurComplement();
 
-  int columns() const { return local_dim_ + global_dim_; }  // per-pose columns first, then global ones
-  int variable_column(int v) const { return linearization_.variable_column(v); }
-  Linearization& linearization() { return linearization_; }
+  int columns() const { return local_dim_ + global_dim_; }  // the groups' columns first, then global ones
+  int variable_column(int v) const { return jacobian_.variable_column(v); }
 
   // J^T J (kept inside) and J^T r (into `gradient`, columns() values) of `slot`.
   void accumulate(int slot, double* gradient);
@@ -140,10 +142,9 @@ class SchurComplement {
   static int runs_cost(const std::vector<ColumnRun>& runs);
   static std::vector<ColumnRun> merge_runs(std::vector<ColumnRun> runs, int local_count);
   void accumulate_gathered(int slot, int f, double* gradient);
-  SchurComplement(const Problem& problem, std::vector<int> variable_column, const std::vector<int>& group_of,
-                  int group_count);
+  SchurComplement(const BlockJacobian& jacobian, const std::vector<int>& group_of, int group_count);
 
-  Linearization linearization_;
+  const BlockJacobian& jacobian_;
   int local_dim_ = 0, global_dim_ = 0;
   std::vector<Group> groups_;
   std::vector<int> coupled_;             // global columns (0-based among the globals)
@@ -157,7 +158,7 @@ class SchurComplement {
   std::vector<FactorPlan> plans_;        // per factor
   std::vector<ColumnRun> runs_;
   std::vector<RunProduct> products_;
-  std::vector<int> gather_column_;       // per factor key (Linearization's order): column in the gathered row, -1 if constant
+  std::vector<int> gather_column_;       // per factor key (the Jacobian's order): column in the gathered row, -1 if constant
   std::vector<double> gathered_, gathered_gradient_;  // scratch of the widest gathered factor
   std::vector<BlockOp> ops_;             // of the factors not gathered, in order
   std::vector<int> op_begin_;            // per factor into ops_ (+1 at the end)

@@ -1,4 +1,4 @@
-#include "solver/nls/normal_equations.h"
+#include "solver/linalg/normal_equations.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,23 +6,17 @@
 namespace cdpr {
 namespace {
 
-// Per-pose variables first, then the global ones that couple all poses: in
-// that order the natural ordering is already arrow-shaped (CHOLMOD applies
-// AMD on top anyway).
-bool is_per_pose(const Key& key) {
-  return key.kind == VariableKind::kPose || key.kind == VariableKind::kReferenceForce;
-}
-
-std::vector<int> per_pose_first_columns(const Problem& problem, int* columns) {
-  const auto& variables = problem.variables();
-  const int nv = static_cast<int>(variables.size());
+// The grouped variables first, then the kept ones, each in variable order.
+std::vector<int> grouped_first_columns(const BlockJacobian& jacobian, const EliminationOrder& order,
+                                       int* columns) {
+  const int nv = jacobian.variable_count();
   std::vector<int> variable_column(nv, -1);
   *columns = 0;
   for (int pass = 0; pass < 2; ++pass) {
     for (int v = 0; v < nv; ++v) {
-      if (variables[v].constant || is_per_pose(variables[v].key) != (pass == 0)) continue;
+      if (jacobian.constant(v) || (order.group[v] != EliminationOrder::kKept) != (pass == 0)) continue;
       variable_column[v] = *columns;
-      *columns += variables[v].tangent_dim;
+      *columns += jacobian.variable_dim(v);
     }
   }
   return variable_column;
@@ -30,12 +24,12 @@ std::vector<int> per_pose_first_columns(const Problem& problem, int* columns) {
 
 }  // namespace
 
-NormalEquations::NormalEquations(const Problem& problem)
-    : linearization_(problem, per_pose_first_columns(problem, &columns_)) {
-  const auto& variables = problem.variables();
-  const int nv = static_cast<int>(variables.size());
-  const int nf = linearization_.factor_count();
-  auto column_of = [&](int v) { return linearization_.variable_column(v); };
+NormalEquations::NormalEquations(BlockJacobian& jacobian, const EliminationOrder& order) : jacobian_(jacobian) {
+  jacobian.assign_columns(grouped_first_columns(jacobian, order, &columns_));
+  const int nv = jacobian_.variable_count();
+  const int nf = jacobian_.factor_count();
+  auto column_of = [&](int v) { return jacobian_.variable_column(v); };
+  auto dim = [&](int v) { return jacobian_.variable_dim(v); };
 
   // Block rows of each block column (indexed by the column's variable),
   // upper triangle: a row variable's first column <= the column variable's.
@@ -44,12 +38,12 @@ NormalEquations::NormalEquations(const Problem& problem)
     if (column_of(v) >= 0) block_rows[v].push_back(v);
   }
   for (int f = 0; f < nf; ++f) {
-    const int nk = linearization_.key_count(f);
+    const int nk = jacobian_.key_count(f);
     for (int a = 0; a < nk; ++a) {
-      const int va = linearization_.key_variable(f, a);
+      const int va = jacobian_.key_variable(f, a);
       if (column_of(va) < 0) continue;
       for (int b = 0; b < nk; ++b) {
-        const int vb = linearization_.key_variable(f, b);
+        const int vb = jacobian_.key_variable(f, b);
         if (column_of(vb) >= 0 && column_of(va) < column_of(vb)) block_rows[vb].push_back(va);
       }
     }
@@ -64,9 +58,9 @@ NormalEquations::NormalEquations(const Problem& problem)
   std::vector<int> column_variable(columns_);
   std::size_t nonzeros = 0;
   for (int v = 0; v < nv; ++v) {
-    for (int d = 0; d < variables[v].tangent_dim && column_of(v) >= 0; ++d) {
+    for (int d = 0; d < dim(v) && column_of(v) >= 0; ++d) {
       column_variable[column_of(v) + d] = v;
-      for (int r : block_rows[v]) nonzeros += r == v ? d + 1 : variables[r].tangent_dim;
+      for (int r : block_rows[v]) nonzeros += r == v ? d + 1 : dim(r);
     }
   }
   row_indices_.reserve(nonzeros);
@@ -75,7 +69,7 @@ NormalEquations::NormalEquations(const Problem& problem)
     const int v = column_variable[c];
     for (int r : block_rows[v]) {
       const int first = column_of(r);
-      const int last = r == v ? c : first + variables[r].tangent_dim - 1;
+      const int last = r == v ? c : first + dim(r) - 1;
       for (int row = first; row <= last; ++row) row_indices_.push_back(row);
     }
     column_starts_[c + 1] = static_cast<int>(row_indices_.size());
@@ -89,15 +83,15 @@ NormalEquations::NormalEquations(const Problem& problem)
   std::vector<int> bucket_start(nv + 1, 0);  // blocks per column variable, then prefix sums
   for (int f = 0; f < nf; ++f) {
     block_begin_.push_back(static_cast<int>(blocks_.size()));
-    const int nk = linearization_.key_count(f);
+    const int nk = jacobian_.key_count(f);
     for (int a = 0; a < nk; ++a) {
       for (int b = a; b < nk; ++b) {
         int ka = a, kb = b;
-        const int va = linearization_.key_variable(f, ka), vb = linearization_.key_variable(f, kb);
+        const int va = jacobian_.key_variable(f, ka), vb = jacobian_.key_variable(f, kb);
         if (column_of(va) < 0 || column_of(vb) < 0) continue;
         if (column_of(va) > column_of(vb)) std::swap(ka, kb);
         blocks_.push_back({ka, kb, -1});
-        ++bucket_start[linearization_.key_variable(f, kb) + 1];
+        ++bucket_start[jacobian_.key_variable(f, kb) + 1];
       }
     }
   }
@@ -110,7 +104,7 @@ NormalEquations::NormalEquations(const Problem& problem)
     for (int f = 0; f < nf; ++f) {
       for (int b = block_begin_[f]; b < block_begin_[f + 1]; ++b) {
         block_factor[b] = f;
-        bucket[next[linearization_.key_variable(f, blocks_[b].column_key)]++] = b;
+        bucket[next[jacobian_.key_variable(f, blocks_[b].column_key)]++] = b;
       }
     }
   }
@@ -119,11 +113,11 @@ NormalEquations::NormalEquations(const Problem& problem)
     int offset = 0;
     for (int r : block_rows[v]) {
       row_offset[r] = offset;
-      offset += variables[r].tangent_dim;
+      offset += dim(r);
     }
     for (int i = bucket_start[v]; i < bucket_start[v + 1]; ++i) {
       BlockRef& block = blocks_[bucket[i]];
-      block.within = row_offset[linearization_.key_variable(block_factor[bucket[i]], block.row_key)];
+      block.within = row_offset[jacobian_.key_variable(block_factor[bucket[i]], block.row_key)];
     }
   }
 }
@@ -131,7 +125,7 @@ NormalEquations::NormalEquations(const Problem& problem)
 void NormalEquations::accumulate(int slot, double* jtj, double* gradient) const {
   std::fill(jtj, jtj + nonzeros(), 0.0);
   std::fill(gradient, gradient + columns_, 0.0);
-  const Linearization& lin = linearization_;
+  const BlockJacobian& lin = jacobian_;
   for (int f = 0; f < lin.factor_count(); ++f) {
     const int m = lin.residual_dim(f);
     lin.add_gradient(slot, f, gradient);
