@@ -1,7 +1,9 @@
 #pragma once
 // Central-difference Jacobians of a Factor with respect to the tangent
 // perturbations of its variables (pose: d_p then d_theta on the right), to
-// check every analytic Jacobian (GTSAM factorTesting.h in spirit).
+// check every analytic Jacobian (GTSAM factorTesting.h in spirit). The
+// perturbation is the solver's own retraction (retract_ambient), so a
+// Jacobian is checked against the steps the solver takes.
 
 #include <limits>
 #include <vector>
@@ -11,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "solver/nls/factor.h"
+#include "solver/nls/problem.h"
 
 namespace cdpr::test {
 
@@ -21,21 +24,12 @@ struct TestVariable {
   int tangent_dim() const { return is_pose ? 6 : static_cast<int>(ambient.size()); }
 };
 
+// The variable's ambient values moved by h along tangent coordinate j.
 inline std::vector<double> perturbed(const TestVariable& v, int j, double h) {
   std::vector<double> out = v.ambient;
-  if (!v.is_pose) {
-    out[j] += h;
-    return out;
-  }
-  if (j < 3) {
-    out[j] += h;
-    return out;
-  }
-  Eigen::Vector3d axis = Eigen::Vector3d::Zero();
-  axis(j - 3) = 1.0;
-  const Eigen::Quaterniond q(v.ambient[3], v.ambient[4], v.ambient[5], v.ambient[6]);
-  const Eigen::Quaterniond qp = q * Eigen::Quaterniond(Eigen::AngleAxisd(h, axis));
-  out[3] = qp.w(); out[4] = qp.x(); out[5] = qp.y(); out[6] = qp.z();
+  std::vector<double> step(v.tangent_dim(), 0.0);
+  step[j] = h;
+  retract_ambient(v.is_pose, static_cast<int>(out.size()), step.data(), out.data());
   return out;
 }
 
