@@ -31,9 +31,9 @@ struct StaticPose {
   double height_residual_m = 0.0;  // max |catenary end height - attachment height| at the solution
 };
 
-// Solves as above by damped Newton with a finite-difference Jacobian. The
-// error says why there is no equilibrium (a cable would push, singular
-// statics, no convergence).
+// Solves as above by Levenberg-Marquardt (the solver's trust-region
+// strategy) with a finite-difference Jacobian. The error says why there is
+// no equilibrium (a cable would push, the statics fail, no convergence).
 Expected<StaticPose, std::string> solve_static_pose(const Robot& robot,
                                                     const std::array<Eigen::Vector3d, kCableCount>& anchors,
                                                     const Eigen::Vector3d& position_world);
