@@ -6,6 +6,7 @@
 
 #include "solver/model/catenary.h"
 #include "solver/model/platform_statics.h"
+#include "solver/nls/trust_region_strategy.h"
 
 namespace cdpr {
 
@@ -85,30 +86,25 @@ std::optional<ReferenceForceMap> force_map(const Robot& robot, const std::array<
   return map;
 }
 
-// Levenberg-Marquardt on the fit's residuals over N unknowns x, with the
-// damping of the solver's own loop (Nielsen's update, as Ceres'
-// LevenbergMarquardtStrategy): a step is taken when the cost falls by more
-// than 1e-3 of what the model predicts; the damping of the normal matrix's
-// diagonal then shrinks smoothly with the gain ratio rho, and after a
-// refused trial it grows by nu = 2, 4, 8, ... (a fixed factor of ten up and
-// down made the trials alternate between two dampings, one overshooting
-// and one creeping, up to the trial cap). It stops when a step gains less
-// than kStopGain of the cost, and, without evaluating, once the model
-// predicts no more than that: near the minimum rounding would refuse trial
-// after trial. At most 50 trials.
+// Levenberg-Marquardt on the fit's residuals over N unknowns x, its steps
+// judged and its damping set by the solver's TrustRegionStrategy: a trial
+// minimises the model with the normal matrix's diagonal scaled by
+// 1 + 1/radius. It stops when a step gains less than kStopGain of the cost,
+// and, without evaluating, once the model predicts no more than that: near
+// the minimum rounding would refuse trial after trial. At most 50 trials.
 //
 // `evaluate(x, residual, jacobian)` is false outside the model;
 // `propose(x, H, g)` gives the trial point from the damped normal matrix H
 // and gradient g. False when the start x cannot be evaluated; else x is the
 // best point found.
 // A start needs its forces and heading near their minimum, not at it: the
-// calibration refines them with everything else. With the anchors metres
-// off the residuals are hundreds of sigmas and Gauss-Newton converges only
-// linearly (about a quarter of the gap left per step), so at a stop of
-// 1e-12 some poses' heading refinements took a dozen more evaluations for
-// digits the calibration's result does not depend on (at 1e-7, 1e-9 and
-// 1e-6 every accuracy seed's anchor and offset errors are the same).
+// calibration refines them with everything else, and with the anchors
+// metres off Gauss-Newton converges only linearly here, so the stop is
+// loose (the calibration's result does not depend on the digits beyond it).
 constexpr double kStopGain = 1e-7;
+
+// Damping 1e-3 at the start, never below 1e-9, given up above 1e12.
+constexpr TrustRegionOptions kStartTrustRegion{1e3, 1e9, 1e-12};
 
 template <int N, typename Evaluate, typename Propose>
 bool damped_gauss_newton(Eigen::Matrix<double, N, 1>& x, const Evaluate& evaluate, const Propose& propose) {
@@ -118,33 +114,27 @@ bool damped_gauss_newton(Eigen::Matrix<double, N, 1>& x, const Evaluate& evaluat
   Jacobian jacobian, trial_jacobian;
   if (!evaluate(x, residual, jacobian)) return false;
   double cost = residual.squaredNorm();
-  double damping = 1e-3, nu = 2.0;
-  for (int iteration = 0; iteration < 50 && damping < 1e12; ++iteration) {
+  TrustRegionStrategy strategy(kStartTrustRegion);
+  for (int iteration = 0; iteration < 50 && !strategy.collapsed(); ++iteration) {
     const Vector gradient = jacobian.transpose() * residual;
     const Eigen::Matrix<double, N, N> jtj = jacobian.transpose() * jacobian;
     Eigen::Matrix<double, N, N> H = jtj;
-    H.diagonal() *= 1.0 + damping;
+    H.diagonal() *= 1.0 + strategy.damping();
     const Vector trial = propose(x, H, gradient);
     const Vector step = trial - x;
     // The cost is |r|^2: the undamped model's decrease is -(2 g's + s'J'Js).
     const double predicted = -(2.0 * gradient.dot(step) + step.dot(jtj * step));
     if (!(predicted > kStopGain * (1.0 + cost))) break;
-    const bool evaluable = evaluate(trial, trial_residual, trial_jacobian);
-    const double trial_cost = evaluable ? trial_residual.squaredNorm() : cost;
-    const double rho = (cost - trial_cost) / predicted;
-    if (evaluable && trial_cost < cost && rho > 1e-3) {
+    const double trial_cost = evaluate(trial, trial_residual, trial_jacobian)
+                                  ? trial_residual.squaredNorm()
+                                  : std::numeric_limits<double>::quiet_NaN();
+    if (strategy.judge_step(cost, trial_cost, predicted)) {
       const bool converged = cost - trial_cost < kStopGain * (1.0 + cost);
       x = trial;
       residual = trial_residual;
       jacobian = trial_jacobian;
       cost = trial_cost;
-      const double t = 2.0 * rho - 1.0;
-      damping = std::max(damping * std::max(1.0 / 3.0, 1.0 - t * t * t), 1e-9);
-      nu = 2.0;
       if (converged) break;
-    } else {
-      damping *= nu;
-      nu *= 2.0;
     }
   }
   return true;

@@ -1,20 +1,26 @@
 #include "solver/model/static_pose.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <utility>
 
-#include <Eigen/LU>
+#include <Eigen/Cholesky>
 
 #include "solver/model/cable_prediction.h"
 #include "solver/model/initial_guess.h"
 #include "solver/model/sample.h"
+#include "solver/nls/trust_region_strategy.h"
 
 namespace cdpr {
 namespace {
 
-constexpr int kMaxIterations = 50;
+constexpr int kMaxIterations = 200;  // trial steps
 constexpr double kHeightToleranceM = 1e-9;
+// Bounds of the damping's diagonal, as the calibration's solver.
+constexpr double kMinDiagonal = 1e-6;
+constexpr double kMaxDiagonal = 1e32;
 
 using Unknowns = Eigen::Vector4d;  // roll [rad], pitch [rad], f_h [N], f_v [N]
 
@@ -62,7 +68,15 @@ std::optional<StaticPose> solve_static_pose(const Robot& robot, const std::array
 
   auto r = residuals(robot, anchors, position_world, u);
   if (!r) return fail("no equilibrium near the level pose (a cable would push or statics singular)");
-  for (int iteration = 0; iteration < kMaxIterations && r->cwiseAbs().maxCoeff() > kHeightToleranceM; ++iteration) {
+  // Levenberg-Marquardt on the four height residuals (a square system: its
+  // least-squares minimum is the root). The initial radius makes the first
+  // steps nearly Newton's; the strategy damps them where the statics turn
+  // sharply or a trial leaves the model (a cable would push).
+  TrustRegionStrategy strategy;
+  double cost = 0.5 * r->squaredNorm();
+  for (int iteration = 0;
+       iteration < kMaxIterations && r->cwiseAbs().maxCoeff() > kHeightToleranceM && !strategy.collapsed();
+       ++iteration) {
     // Central differences: angles step 1e-6 rad, forces relative 1e-6.
     Eigen::Matrix4d jacobian;
     for (int j = 0; j < 4; ++j) {
@@ -75,22 +89,25 @@ std::optional<StaticPose> solve_static_pose(const Robot& robot, const std::array
       if (!r_plus || !r_minus) return fail("statics fail next to the iterate");
       jacobian.col(j) = (*r_plus - *r_minus) / (2.0 * h);
     }
-    const Eigen::FullPivLU<Eigen::Matrix4d> lu(jacobian);
-    if (!lu.isInvertible()) return fail("singular statics Jacobian");
-    const Unknowns step = -lu.solve(*r);
-    // Backtracking: accept the first fraction that lowers the residual.
-    bool accepted = false;
-    for (double fraction = 1.0; fraction > 1e-4; fraction *= 0.5) {
-      const Unknowns trial = u + fraction * step;
-      const auto r_trial = residuals(robot, anchors, position_world, trial);
-      if (r_trial && r_trial->norm() < r->norm()) {
-        u = trial;
-        r = r_trial;
-        accepted = true;
-        break;
-      }
+    const Eigen::Matrix4d jtj = jacobian.transpose() * jacobian;
+    const Eigen::Vector4d gradient = jacobian.transpose() * *r;
+    Eigen::Matrix4d damped = jtj;
+    damped.diagonal() += jtj.diagonal().cwiseMax(kMinDiagonal).cwiseMin(kMaxDiagonal) / strategy.radius();
+    const Eigen::LDLT<Eigen::Matrix4d> ldlt(damped);
+    if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) {
+      strategy.reject_step();
+      continue;
     }
-    if (!accepted) break;
+    const Unknowns step = -ldlt.solve(gradient);
+    const double predicted = -(gradient.dot(step) + 0.5 * step.dot(jtj * step));
+    const Unknowns trial = u + step;
+    const auto r_trial = predicted > 0.0 ? residuals(robot, anchors, position_world, trial) : std::nullopt;
+    const double trial_cost = r_trial ? 0.5 * r_trial->squaredNorm() : std::numeric_limits<double>::quiet_NaN();
+    if (strategy.judge_step(cost, trial_cost, predicted)) {
+      u = trial;
+      r = r_trial;
+      cost = trial_cost;
+    }
   }
 
   StaticPose result;

@@ -10,14 +10,14 @@
 #include "solver/linalg/schur_complement.h"
 #include "solver/linalg/sparse_cholesky.h"
 #include "solver/nls/linearization.h"
+#include "solver/nls/trust_region_strategy.h"
 
 namespace cdpr {
 namespace {
 
-// Ceres' LevenbergMarquardtStrategy constants.
+// Bounds of the damping's diagonal D (Ceres' LevenbergMarquardtStrategy).
 constexpr double kMinDiagonal = 1e-6;
 constexpr double kMaxDiagonal = 1e32;
-constexpr double kMinRelativeDecrease = 1e-3;
 
 [[noreturn]] void die(const std::string& what) {
   std::fprintf(stderr, "cdpr::LevenbergMarquardt: %s\n", what.c_str());
@@ -221,8 +221,7 @@ SolverSummary LevenbergMarquardt::Impl::solve() {
   Stop stop = Stop::kNone;
   if (system->columns() == 0) stop = Stop::kNoVariables;
   else if (it.gradient_max_norm <= options.gradient_tolerance) stop = Stop::kGradient;
-  double radius = options.initial_trust_radius;
-  double nu = 2.0;
+  TrustRegionStrategy strategy({options.initial_trust_radius, options.max_trust_radius, options.min_trust_radius});
   double last_relative_decrease = 0.0, last_step_norm = 0.0;
   int iteration = 0;
   while (stop == Stop::kNone && iteration < options.max_iterations) {
@@ -230,13 +229,16 @@ SolverSummary LevenbergMarquardt::Impl::solve() {
     it = IterationSummary{};
     it.iteration = iteration;
 
+    const double radius = strategy.radius();
     const FactorizationStatus status = system->factorize(radius, nullptr);
     if (status == FactorizationStatus::kFatal) {
       stop = Stop::kFatal;
       break;
     }
     bool accepted = false;
-    if (status == FactorizationStatus::kSuccess) {
+    if (status != FactorizationStatus::kSuccess) {
+      strategy.reject_step();
+    } else {
       for (int c = 0; c < columns(); ++c) rhs[c] = -gradient[c];
       system->solve(rhs.data(), step.data());
       it.step_norm = norm(step);
@@ -253,39 +255,34 @@ SolverSummary LevenbergMarquardt::Impl::solve() {
         double g_dx = 0.0;
         for (int c = 0; c < columns(); ++c) g_dx += gradient[c] * step[c];
         const double predicted = 0.5 * (system->damping_quadratic(step.data(), radius) - g_dx);
-        make_candidate();
         const int other = 1 - slot;
-        double new_cost = 0.0;
-        if (predicted > 0.0 && system->evaluate(candidate.data(), other, &new_cost, &failed)) {
-          const double actual = cost - new_cost;
-          const double rho = actual / predicted;
-          if (rho > kMinRelativeDecrease) {
-            accepted = true;
-            std::copy(candidate.begin(), candidate.end(), problem.state().begin());
-            slot = other;
-            system->accumulate(slot, gradient.data());
-            last_relative_decrease = std::abs(actual) / cost;
-            it.cost_change = actual;
-            cost = new_cost;
-            const double t = 2.0 * rho - 1.0;
-            radius = std::min(options.max_trust_radius, radius / std::max(1.0 / 3.0, 1.0 - t * t * t));
-            nu = 2.0;
-            ++summary.successful_steps;
-            if (last_relative_decrease <= options.function_tolerance) stop = Stop::kFunction;
+        double new_cost = std::numeric_limits<double>::quiet_NaN();
+        if (predicted > 0.0) {
+          make_candidate();
+          if (!system->evaluate(candidate.data(), other, &new_cost, &failed)) {
+            new_cost = std::numeric_limits<double>::quiet_NaN();
           }
+        }
+        // Not evaluable, no model decrease or too small a gain: the strategy
+        // shrinks the trust region (raises the damping).
+        accepted = strategy.judge_step(cost, new_cost, predicted);
+        if (accepted) {
+          const double actual = cost - new_cost;
+          std::copy(candidate.begin(), candidate.end(), problem.state().begin());
+          slot = other;
+          system->accumulate(slot, gradient.data());
+          last_relative_decrease = std::abs(actual) / cost;
+          it.cost_change = actual;
+          cost = new_cost;
+          ++summary.successful_steps;
+          if (last_relative_decrease <= options.function_tolerance) stop = Stop::kFunction;
         }
       }
     }
-    if (!accepted && stop == Stop::kNone) {
-      // Not positive definite, no model decrease, not evaluable or too small
-      // a gain: shrink the trust region (raise the damping).
-      radius /= nu;
-      nu *= 2.0;
-      if (radius < options.min_trust_radius) stop = Stop::kCollapsed;
-    }
+    if (!accepted && stop == Stop::kNone && strategy.collapsed()) stop = Stop::kCollapsed;
     it.cost = cost;
     it.gradient_max_norm = max_abs(gradient);
-    it.trust_radius = radius;
+    it.trust_radius = strategy.radius();
     it.step_accepted = accepted;
     if (accepted && stop == Stop::kNone && it.gradient_max_norm <= options.gradient_tolerance) stop = Stop::kGradient;
     if (options.progress) options.progress(it);
@@ -320,12 +317,12 @@ SolverSummary LevenbergMarquardt::Impl::solve() {
     case Stop::kCollapsed:
       summary.termination = TerminationType::kTrustRegionCollapsed;
       std::snprintf(buffer, sizeof buffer, "trust region radius %.3e below %.3e: no step decreases the cost",
-                    radius, options.min_trust_radius);
+                    strategy.radius(), options.min_trust_radius);
       break;
     case Stop::kFatal: {
       summary.termination = TerminationType::kLinearSolverFailure;
       std::string why;
-      (void)system->factorize(radius, &why);
+      (void)system->factorize(strategy.radius(), &why);
       summary.message = "linear solver failed: " + why;
       return summary;
     }

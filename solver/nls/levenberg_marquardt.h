@@ -12,13 +12,13 @@
 // counts heap allocations). The problem's structure must not change while
 // a solver refers to it; values may (solve() starts from the current ones).
 //
-// Strategy (Ceres' LevenbergMarquardtStrategy): solve
-// (J^T J + D / radius) dx = -J^T r with D = diag(J^T J) clamped to
-// [1e-6, 1e32]; accept when the actual/predicted cost reduction exceeds 1e-3,
-// every factor evaluates and all values are finite, then
-// radius /= max(1/3, 1 - (2 rho - 1)^3); otherwise (also when the damped
-// matrix is not positive definite) radius /= nu, nu *= 2. The candidate is
-// evaluated on a copy of the state, so a rejected step costs no undo.
+// Each iteration solves (J^T J + D / radius) dx = -J^T r with
+// D = diag(J^T J) clamped to [1e-6, 1e32]; a candidate that every factor
+// evaluates is judged, and the radius updated, by the TrustRegionStrategy
+// (solver/nls/trust_region_strategy.h: accepted when the actual/predicted
+// cost reduction exceeds 1e-3). A damped matrix that is not positive
+// definite counts as a refused step. The candidate is evaluated on a copy of
+// the state, so a rejected step costs no undo.
 
 #include <functional>
 #include <memory>
