@@ -110,6 +110,11 @@ std::vector<ReadingResidual> reading_residuals(const BuiltProblem& built, const 
 std::vector<SensorReading> left_out_residuals(const Robot& robot, const BuiltProblem& built,
                                               const CalibrationOptions& options) {
   std::vector<SensorReading> out;
+  // Clean data leave nothing out: no spreads to evaluate every factor for.
+  if (std::none_of(built.samples.begin(), built.samples.end(),
+                   [](const Sample& s) { return left_out_rows(s).count > 0; })) {
+    return out;
+  }
   const ReadingSpreads spreads = reading_spreads(reading_residuals(built, options, robot.reference_cable));
   for (std::size_t k = 0; k < built.samples.size(); ++k) {
     const Sample& sample = built.samples[k];
