@@ -52,9 +52,9 @@
 #include <vector>
 
 #include "hal/button.h"
-#include "solver/calibrate.h"
-#include "solver/robot.h"
-#include "solver/sample.h"
+#include "solver/calibration/calibrate.h"
+#include "solver/model/robot.h"
+#include "solver/model/sample.h"
 #include "src/calibration/calibration_state.h"
 #include "src/calibration/equilibrium_detector.h"
 #include "src/calibration/fit_validation.h"
@@ -81,7 +81,7 @@ struct CalibratorOptions {
 
 using SolveFunction = std::function<CalibrationResult(const Robot&, const std::vector<Sample>&)>;
 
-// A SolveFunction calling solver/calibrate.h with `options`.
+// A SolveFunction calling solver/calibration/calibrate.h with `options`.
 SolveFunction make_solver_function(CalibrationOptions options);
 
 struct CalibratorDevices {

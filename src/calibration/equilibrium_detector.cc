@@ -4,7 +4,7 @@
 #include <cassert>
 #include <cmath>
 
-#include "solver/pose.h"
+#include "solver/nls/pose.h"
 
 namespace cdpr::calibration {
 

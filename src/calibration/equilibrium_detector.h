@@ -31,8 +31,8 @@
 #include <Eigen/Geometry>
 
 #include "hal/clock.h"
-#include "solver/robot.h"
-#include "solver/sample.h"
+#include "solver/model/robot.h"
+#include "solver/model/sample.h"
 
 namespace cdpr::calibration {
 

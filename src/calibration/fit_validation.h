@@ -21,9 +21,9 @@
 #include <string>
 #include <vector>
 
-#include "solver/calibrate.h"
-#include "solver/calibration.h"
-#include "solver/robot.h"
+#include "solver/calibration/calibrate.h"
+#include "solver/model/calibration.h"
+#include "solver/model/robot.h"
 
 namespace cdpr::calibration {
 

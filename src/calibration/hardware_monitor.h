@@ -21,7 +21,7 @@
 #include "hal/load_cell.h"
 #include "hal/pose_source.h"
 #include "hal/winch_bank.h"
-#include "solver/robot.h"
+#include "solver/model/robot.h"
 
 namespace cdpr::calibration {
 

@@ -4,7 +4,7 @@
 #include <limits>
 #include <random>
 
-#include "solver/pose_design.h"
+#include "solver/calibration/pose_design.h"
 #include "src/calibration/message_text.h"
 
 namespace cdpr::calibration {
@@ -153,9 +153,10 @@ WaypointPlan plan_waypoints(const Robot& robot, const std::array<double, kCableC
 
   std::vector<Waypoint> feasible;
   for (const Eigen::Vector3d& position : jittered_grid(box, options)) {
-    auto rest = solve_static_pose(robot, anchors, position);
+    std::string no_rest;
+    auto rest = solve_static_pose(robot, anchors, position, &no_rest);
     if (!rest) {
-      plan.rejected.push_back({position, rest.error()});
+      plan.rejected.push_back({position, std::move(no_rest)});
       continue;
     }
     Waypoint waypoint{std::move(*rest), {}};
@@ -183,8 +184,9 @@ WaypointPlan plan_waypoints(const Robot& robot, const std::array<double, kCableC
 
 Expected<std::array<double, kCableCount>, std::string> estimate_payout_offsets(
     const Robot& robot, const Eigen::Vector3d& position_world, const std::array<double, kCableCount>& encoder_m) {
-  const auto rest = solve_static_pose(robot, nominal_anchors(robot), position_world);
-  if (!rest) return Unexpected{"cannot model the start pose: " + rest.error()};
+  std::string no_rest;
+  const auto rest = solve_static_pose(robot, nominal_anchors(robot), position_world, &no_rest);
+  if (!rest) return Unexpected{"cannot model the start pose: " + no_rest};
   std::array<double, kCableCount> offsets{};
   for (int i = 0; i < kCableCount; ++i) offsets[i] = encoder_m[i] - rest->arc_length_m[i];
   return offsets;

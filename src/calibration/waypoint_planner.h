@@ -2,7 +2,7 @@
 // Plans the static poses of one field calibration from the nominal geometry
 // (docs/DESIGN.md step 3): well spread over the workspace so that anchors and
 // offsets are observable, each converted to winch payout targets with the
-// sagging-cable model (static_pose.h) and checked against the limits.
+// sagging-cable model (solver/model/static_pose.h) and checked against the limits.
 //
 // Workspace: the anchors' horizontal bounding box inset by `margin_m` on each
 // side, times the world-z band [z_min_m, z_max_m]. Candidates: a jittered grid
@@ -31,8 +31,9 @@
 
 #include <Eigen/Core>
 
-#include "solver/robot.h"
-#include "src/calibration/static_pose.h"
+#include "solver/model/robot.h"
+#include "solver/model/static_pose.h"
+#include "src/formats/expected.h"
 
 namespace cdpr::calibration {
 
@@ -41,7 +42,7 @@ enum class WaypointSelection {
   // Farthest-point: the first nearest the box centre, then each the farthest
   // from those chosen. Spread evenly, whatever the geometry.
   kSpread,
-  // A-optimal (solver/pose_design.h): each the one that lowers the summed
+  // A-optimal (solver/calibration/pose_design.h): each the one that lowers the summed
   // Cramer-Rao variance of anchors and offsets most, on the nominal anchors.
   // Smaller anchor and offset sigmas than kSpread for the same count
   // (docs/calibration.md); poses crowd towards the workspace's edges.

@@ -34,7 +34,7 @@
 #include "hal/load_cell.h"
 #include "hal/pose_source.h"
 #include "hal/winch_bank.h"
-#include "solver/robot.h"
+#include "solver/model/robot.h"
 #include "src/calibration/calibration_state_machine.h"
 #include "src/daemon/control_server.h"
 #include "src/daemon/daemon_config.h"

@@ -4,7 +4,7 @@
 #include <string>
 #include <string_view>
 
-#include "solver/calibration.h"
+#include "solver/model/calibration.h"
 #include "src/formats/expected.h"
 #include "src/formats/format_error.h"
 #include "src/formats/text_file.h"

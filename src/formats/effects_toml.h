@@ -9,7 +9,7 @@
 
 #include <toml++/toml.h>
 
-#include "solver/calibration.h"
+#include "solver/model/calibration.h"
 #include "src/formats/toml_reader.h"
 
 namespace cdpr::formats {

@@ -5,7 +5,7 @@
 #include <string>
 #include <string_view>
 
-#include "solver/robot.h"
+#include "solver/model/robot.h"
 #include "src/formats/expected.h"
 #include "src/formats/format_error.h"
 

@@ -7,7 +7,7 @@
 #include <string_view>
 #include <vector>
 
-#include "solver/sample.h"
+#include "solver/model/sample.h"
 #include "src/formats/expected.h"
 #include "src/formats/format_error.h"
 

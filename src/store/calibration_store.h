@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include "solver/calibration.h"
+#include "solver/model/calibration.h"
 #include "src/store/atomic_file.h"
 #include "src/store/store_error.h"
 

@@ -15,7 +15,7 @@
 #include <string>
 #include <string_view>
 
-#include "solver/calibration.h"
+#include "solver/model/calibration.h"
 #include "src/store/calibration_store.h"
 #include "src/store/store_error.h"
 

@@ -10,7 +10,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "../solver/test_robots.h"
+#include "../solver/model/test_robots.h"
 #include "calibctl/control_client.h"
 #include "daemon_process.h"
 #include "src/formats/robot_toml.h"

@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "solver/pose_design.h"
+#include "solver/calibration/pose_design.h"
 #include "src/formats/calibration_toml.h"
 #include "src/formats/robot_toml.h"
 #include "src/formats/samples_csv.h"

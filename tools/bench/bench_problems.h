@@ -9,10 +9,10 @@
 
 #include <ceres/solver.h>
 
-#include "solver/calibrate.h"
-#include "solver/levenberg_marquardt.h"
-#include "solver/robot.h"
-#include "solver/sample.h"
+#include "solver/calibration/calibrate.h"
+#include "solver/nls/levenberg_marquardt.h"
+#include "solver/model/robot.h"
+#include "solver/model/sample.h"
 
 namespace cdpr::bench {
 

@@ -12,7 +12,7 @@
 namespace cdpr::bench {
 namespace {
 
-// Right perturbation of solver/pose.h: p + d_p, q * Exp(d_theta).
+// Right perturbation of solver/nls/pose.h: p + d_p, q * Exp(d_theta).
 class PoseManifold final : public ceres::Manifold {
  public:
   int AmbientSize() const override { return 7; }

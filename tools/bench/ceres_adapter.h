@@ -9,7 +9,7 @@
 
 #include <ceres/ceres.h>
 
-#include "solver/problem.h"
+#include "solver/nls/problem.h"
 
 namespace cdpr::bench {
 

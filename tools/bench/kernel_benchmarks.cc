@@ -9,11 +9,12 @@
 #include <benchmark/benchmark.h>
 
 #include "bench_problems.h"
-#include "solver/keys.h"
-#include "solver/normal_equations.h"
-#include "solver/schur_complement.h"
-#include "solver/sparse_cholesky.h"
-#include "solver/static_pose_factor.h"
+#include "solver/linalg/normal_equations.h"
+#include "solver/linalg/schur_complement.h"
+#include "solver/linalg/sparse_cholesky.h"
+#include "solver/nls/keys.h"
+#include "solver/nls/linearization.h"
+#include "solver/calibration/static_pose_factor.h"
 
 namespace cdpr::bench {
 namespace {
@@ -59,10 +60,11 @@ void BM_StaticPoseFactorEvaluate(benchmark::State& state) {
 // takes BM_SchurRefactorisation's path). Symbolic analysis outside the loop.
 void BM_NumericRefactorisation(benchmark::State& state) {
   BuiltProblem built = build_problem(bench_data(kKernelPoses));
-  NormalEquations normal(*built.problem);
+  Linearization linearization(*built.problem);
+  NormalEquations normal(linearization.jacobian(), built.problem->elimination_order());
   double cost = 0.0;
   int failed = -1;
-  if (!normal.evaluate(built.problem->state().data(), 0, &cost, &failed)) {
+  if (!linearization.evaluate(built.problem->state().data(), 0, &cost, &failed)) {
     state.SkipWithError("factor not evaluable at the start");
     return;
   }
@@ -90,14 +92,16 @@ void BM_NumericRefactorisation(benchmark::State& state) {
 // Per pose count, to show it grows linearly.
 void BM_SchurRefactorisation(benchmark::State& state) {
   BuiltProblem built = build_problem(bench_data(static_cast<int>(state.range(0))));
-  std::unique_ptr<SchurComplement> schur = SchurComplement::create(*built.problem);
+  Linearization linearization(*built.problem);
+  std::unique_ptr<SchurComplement> schur =
+      SchurComplement::create(linearization.jacobian(), built.problem->elimination_order());
   if (!schur) {
     state.SkipWithError("the calibration problem has no per-pose structure");
     return;
   }
   double cost = 0.0;
   int failed = -1;
-  if (!schur->linearization().evaluate(built.problem->state().data(), 0, &cost, &failed)) {
+  if (!linearization.evaluate(built.problem->state().data(), 0, &cost, &failed)) {
     state.SkipWithError("factor not evaluable at the start");
     return;
   }

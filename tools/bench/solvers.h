@@ -5,7 +5,7 @@
 // builds a ceres::Problem over the same factors and state and solves.
 
 #include "bench_problems.h"
-#include "solver/problem.h"
+#include "solver/nls/problem.h"
 #include "summary.h"
 
 namespace cdpr::bench {

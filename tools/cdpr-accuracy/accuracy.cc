@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "sim/dataset.h"
-#include "solver/pose_design.h"
+#include "solver/calibration/pose_design.h"
 
 namespace cdpr::accuracy {
 

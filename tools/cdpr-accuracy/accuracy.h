@@ -13,7 +13,7 @@
 #include "sim/outliers.h"
 #include "sim/presets.h"
 #include "sim/true_robot.h"
-#include "solver/calibrate.h"
+#include "solver/calibration/calibrate.h"
 
 namespace cdpr::accuracy {
 
@@ -45,7 +45,7 @@ struct RunResult {
   // What the information allows, each a mean over cables of the anchor's
   // sigma norm sqrt(sx^2 + sy^2 + sz^2) (the RMS of |a - a_true|):
   double reported_sigma_m = 0.0;  // from the fit's own covariance (0 when it failed)
-  double straight_bound_m = 0.0;  // Cramer-Rao, straight cables, true robot and poses (solver/pose_design.h)
+  double straight_bound_m = 0.0;  // Cramer-Rao, straight cables, true robot and poses (solver/calibration/pose_design.h)
   // Gross errors: planted (encoder >= 0.3 m, and force spikes), how many of
   // them were rejected, and clean rows (no planted error) rejected.
   int planted_encoder = 0, recalled_encoder = 0, planted_force = 0, recalled_force = 0;

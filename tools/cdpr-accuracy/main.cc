@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
       ->delimiter(',')->expected(6);
   app.add_option("--design", design_candidates,
                  "0: poses spread evenly over the box; N: the most informative of N feasible candidates "
-                 "(A-optimal on the nominal anchors, solver/pose_design.h)")
+                 "(A-optimal on the nominal anchors, solver/calibration/pose_design.h)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--noise-scale", noise_scale,
                  "multiplies the preset's sensor noise; 0 = noiseless data fitted with the preset's sigmas, so the "

@@ -5,7 +5,7 @@
 #include <limits>
 
 #include "sim/dataset.h"
-#include "solver/cable_prediction.h"
+#include "solver/model/cable_prediction.h"
 
 namespace cdpr::accuracy {
 

@@ -1,6 +1,6 @@
 #pragma once
 // `cdpr-calib diagnose`: robot.toml + samples.csv -> which known effect the
-// data show (solver/diagnosis.h), a text and HTML report and the calibration
+// data show (solver/diagnosis/diagnosis.h), a text and HTML report and the calibration
 // of the final model.
 
 #include <string>

@@ -6,8 +6,8 @@
 #include <optional>
 #include <string>
 
-#include "solver/calibration.h"
-#include "solver/diagnosis.h"
+#include "solver/model/calibration.h"
+#include "solver/diagnosis/diagnosis.h"
 
 namespace cdpr::tools {
 

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "solver/robot.h"
-#include "solver/sample.h"
+#include "solver/model/robot.h"
+#include "solver/model/sample.h"
 
 namespace cdpr::tools {
 

@@ -1,6 +1,6 @@
 #pragma once
 // The --model option of cdpr-calib: a cable model (catenary or rigid) and
-// optional model terms (solver/effects.h), e.g. "catenary,elasticity,load_cell_bias".
+// optional model terms (solver/model/effects.h), e.g. "catenary,elasticity,load_cell_bias".
 
 #include <optional>
 #include <string>
@@ -8,7 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "solver/calibrate.h"
+#include "solver/calibration/calibrate.h"
 
 namespace cdpr::tools {
 

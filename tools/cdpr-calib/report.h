@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <string>
 
-#include "solver/calibrate.h"
+#include "solver/calibration/calibrate.h"
 
 namespace cdpr::tools {
 

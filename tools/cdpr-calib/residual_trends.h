@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "solver/held_out.h"
+#include "solver/diagnosis/held_out.h"
 
 namespace cdpr::tools {
 

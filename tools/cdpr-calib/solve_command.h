@@ -5,7 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "solver/calibrate.h"
+#include "solver/calibration/calibrate.h"
 
 namespace cdpr::tools {
 

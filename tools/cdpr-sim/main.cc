@@ -95,7 +95,7 @@ int main(int argc, char** argv) {
                  "which spans the paper's Table I ranges; a wider box makes the anchors better observable)");
   app.add_option("--design", config.design_candidates,
                  "0: poses spread evenly over the box; N: the --poses most informative of N feasible candidates "
-                 "(D-optimal on the nominal anchors, solver/pose_design.h)")
+                 "(D-optimal on the nominal anchors, solver/calibration/pose_design.h)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--noise-scale", config.noise_scale,
                  "multiplies every sensor sigma (encoder 10 mm, force 5 N large / 1 N small, pose 5 mm, 0.01 rad); 0 = noiseless")

@@ -6,7 +6,7 @@
 #include "sim/sensors.h"
 #include "sim/stream_purpose.h"
 #include "sim/waypoints.h"
-#include "solver/pose_design.h"
+#include "solver/calibration/pose_design.h"
 
 namespace cdpr::sim {
 namespace {

@@ -18,9 +18,9 @@
 #include "sim/outliers.h"
 #include "sim/presets.h"
 #include "sim/true_robot.h"
-#include "solver/calibration.h"
-#include "solver/robot.h"
-#include "solver/sample.h"
+#include "solver/model/calibration.h"
+#include "solver/model/robot.h"
+#include "solver/model/sample.h"
 #include "src/formats/expected.h"
 
 namespace cdpr::sim {
@@ -41,7 +41,7 @@ struct DatasetConfig {
   // Pose design. 0: the first pose_count feasible candidates of the waypoint
   // sequence (an even spread). N > 0: N feasible candidates, of which the
   // pose_count most informative about anchors and offsets are measured
-  // (solver/pose_design.h, A-optimal, judged with the NOMINAL anchors as a
+  // (solver/calibration/pose_design.h, A-optimal, judged with the NOMINAL anchors as a
   // planner must).
   int design_candidates = 0;
   // Gross errors planted after the measurement (sim/outliers.h): a fraction

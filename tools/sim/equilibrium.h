@@ -14,7 +14,7 @@
 
 #include "sim/equilibrium_state.h"
 #include "sim/true_robot.h"
-#include "solver/pose.h"
+#include "solver/nls/pose.h"
 #include "src/formats/expected.h"
 
 namespace cdpr::sim {

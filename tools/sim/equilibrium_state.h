@@ -7,8 +7,8 @@
 
 #include <Eigen/Core>
 
-#include "solver/pose.h"
-#include "solver/robot.h"
+#include "solver/nls/pose.h"
+#include "solver/model/robot.h"
 
 namespace cdpr::sim {
 

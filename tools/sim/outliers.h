@@ -12,8 +12,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "solver/calibration.h"
-#include "solver/sample.h"
+#include "solver/model/calibration.h"
+#include "solver/model/sample.h"
 
 namespace cdpr::sim {
 

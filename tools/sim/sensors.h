@@ -12,7 +12,7 @@
 //   position    = true + N(0, (k sigma_pos)^2 I)
 //   orientation = true * Exp(xi), xi ~ N(0, (k sigma_rot)^2 I): a rotation
 //                 vector in the platform frame (the right perturbation of
-//                 solver/pose.h; the paper's exp of a twist, split into its
+//                 solver/nls/pose.h; the paper's exp of a twist, split into its
 //                 translation and rotation parts).
 // s_i, gain, bias from the robot's hidden effects, offsets from the robot,
 // sigmas from robot.noise, k = noise_scale (0: noiseless).
@@ -20,7 +20,7 @@
 #include "sim/equilibrium_state.h"
 #include "sim/rng.h"
 #include "sim/true_robot.h"
-#include "solver/sample.h"
+#include "solver/model/sample.h"
 
 namespace cdpr::sim {
 

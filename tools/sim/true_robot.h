@@ -8,8 +8,8 @@
 
 #include <Eigen/Core>
 
-#include "solver/calibration.h"
-#include "solver/robot.h"
+#include "solver/model/calibration.h"
+#include "solver/model/robot.h"
 
 namespace cdpr::sim {
 

@@ -22,7 +22,7 @@
 
 #include "sim/equilibrium.h"
 #include "sim/true_robot.h"
-#include "solver/pose.h"
+#include "solver/nls/pose.h"
 #include "src/formats/expected.h"
 
 namespace cdpr::virtual_robot {

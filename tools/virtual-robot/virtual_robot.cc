@@ -10,7 +10,7 @@
 #include "sim/stream_purpose.h"
 #include "virtual-robot/modbus_rtu_server.h"
 #include "virtual-robot/modbus_tcp_server.h"
-#include "solver/pose.h"
+#include "solver/nls/pose.h"
 #include "src/formats/calibration_toml.h"
 #include "src/formats/robot_toml.h"
 

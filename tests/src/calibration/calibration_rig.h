@@ -15,7 +15,7 @@
 #include "../../fakes/fake_pose_source.h"
 #include "../../fakes/fake_winch_bank.h"
 #include "../../fakes/manual_clock.h"
-#include "../../solver/test_robots.h"
+#include "../../solver/model/test_robots.h"
 #include "../store/store_test_support.h"
 #include "src/calibration/calibration_state_machine.h"
 

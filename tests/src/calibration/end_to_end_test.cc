@@ -1,4 +1,4 @@
-// The state machine with the real solver (solver/calibrate.h) on data that
+// The state machine with the real solver (solver/calibration/calibrate.h) on data that
 // the catenary model explains exactly: the platform rests at each planned
 // pose, the encoders read the planned payouts and the load cell the modelled
 // reference tension. The fit must then give back the geometry the data came

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "../../solver/test_robots.h"
+#include "../../solver/model/test_robots.h"
 
 namespace cdpr::calibration {
 namespace {

@@ -2,12 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include <gtest/gtest.h>
 
-#include "../../solver/test_robots.h"
-#include "solver/cable_prediction.h"
-#include "solver/pose_design.h"
+#include "../../solver/model/test_robots.h"
+#include "solver/model/cable_prediction.h"
+#include "solver/calibration/pose_design.h"
 
 namespace cdpr::calibration {
 namespace {
@@ -30,9 +31,10 @@ TEST(StaticPose, RestPoseBalancesTheWeightAndReachesEveryAttachment) {
   const Robot robot = test::large_robot();
   const Eigen::Vector3d position(80.0, 140.0, 20.0);
   // WHEN its rest pose is solved
-  const auto rest = solve_static_pose(robot, nominal_anchors(robot), position);
+  std::string why;
+  const auto rest = solve_static_pose(robot, nominal_anchors(robot), position, &why);
   // THEN the cables carry the platform's weight vertically and every catenary ends at its attachment
-  ASSERT_TRUE(rest) << rest.error();
+  ASSERT_TRUE(rest) << why;
   const auto cables = predict_cables(robot, nominal_anchors(robot), rest->world_T_platform, rest->reference_force);
   ASSERT_TRUE(cables.has_value());
   double lift_n = 0.0;

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "../../solver/test_robots.h"
+#include "../../solver/model/test_robots.h"
 #include "src/daemon/daemon_config.h"
 
 namespace cdpr::daemon {

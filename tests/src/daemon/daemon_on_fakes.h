@@ -10,7 +10,7 @@
 #include "../../fakes/fake_pose_source.h"
 #include "../../fakes/fake_winch_bank.h"
 #include "../../fakes/manual_clock.h"
-#include "../../solver/test_robots.h"
+#include "../../solver/model/test_robots.h"
 #include "src/daemon/daemon_loop.h"
 
 namespace cdpr::daemon::test {

@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <string>
 
-#include "solver/calibration.h"
+#include "solver/model/calibration.h"
 #include "src/store/atomic_file.h"
 
 namespace cdpr::store::test {

@@ -1,0 +1,127 @@
+#pragma once
+// One calibration from measured static poses: build the factor graph of the
+// paper (Sec. IV) from nominal anchors and the data alone, solve it, and
+// extract anchors and offsets with their 1-sigma from the covariance.
+// Pure numerics: no I/O, no clock; progress is reported through a callback.
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "solver/model/calibration.h"
+#include "solver/model/effects.h"
+#include "solver/nls/levenberg_marquardt.h"
+#include "solver/nls/loss.h"
+#include "solver/nls/problem.h"
+#include "solver/model/robot.h"
+#include "solver/model/sample.h"
+
+namespace cdpr {
+
+enum class CableModelKind { kRigid, kCatenary };
+
+struct CalibrationOptions {
+  CableModelKind cable_model = CableModelKind::kCatenary;
+  // A Huber loss of this width [sigma] on the readings (and the pose prior)
+  // of the final fit; <= 0: least squares. Gross errors are the robust
+  // fit's business (below), not this.
+  double huber_width = 0.0;
+  // Robust fit (default): a Huber fit (convex, so it reaches the basin a
+  // least-squares fit would from the same start while a few gross errors
+  // pull only linearly), then, when a reading still stands out, a Cauchy fit
+  // from there (redescending: a gross error's pull fades, graduated
+  // non-convexity), then the test of solver/calibration/gross_errors.h on every reading;
+  // the rows of rejected readings are left out and the fit is redone by
+  // least squares. On clean data this ends at the least-squares minimum with
+  // its covariance. false: least squares (or huber_width) alone.
+  bool robust = true;
+  double rejection_threshold_sigma = 5.0;  // normalised residual of a gross error
+  // More rejected rows than this fraction and the calibration is refused:
+  // the robot or its sensors need attention (or the model does not fit).
+  double max_rejected_fraction = 0.4;
+  // The model-fit test: the final fit's chi-square against its degrees of
+  // freedom; a model that does not fit at this significance is reported in
+  // Calibration::model_warning and its sigmas are scaled up by the misfit.
+  double misfit_alpha = 1e-3;
+  // Well-determined fits take 10-60; a few with sparse data (8 poses on the
+  // small robot) crawl along a flat valley for 250-450 before converging,
+  // and stopping them at 200 left them up to 0.3 m short even on noiseless data.
+  int max_iterations = 1000;
+  // Sigma [m] of the attachment-height consistency of Eq. (15): a model
+  // identity, not a sensor, so it is held much tighter than the pose noise.
+  double height_sigma_m = 1e-2;
+  // Model terms fitted on top of the catenary (solver/model/effects.h), each with
+  // its own EffectKey variable started at 0 ("absent"); catenary only.
+  std::vector<Effect> effects;
+  std::function<void(const IterationSummary&)> progress;  // may be empty
+};
+
+// One fitted model term in the solver's parameter units (solver/model/effects.h).
+struct FittedEffect {
+  Effect effect = Effect::kElasticity;
+  std::vector<double> value;
+  std::vector<double> sigma;  // 1-sigma from the covariance
+};
+
+struct CalibrationResult {
+  bool ok = false;
+  std::string message;      // why it failed, or the solver's termination message
+  Calibration calibration;  // filled when ok (created/robot left to the caller)
+  SolverSummary solver;
+  std::vector<int> rejected_samples;  // sample ids refused before the solve, with reasons in message
+  // Gross errors found by the robust fit (also in calibration.rejected): its
+  // rows were left out of the final fit. Filled when ok and when refused for
+  // too many of them.
+  std::vector<SensorReading> gross_errors;
+  // Each reading left out of this fit (Sample::encoder_left_out,
+  // force_left_out) as the fit predicts it: its normalised residual, its
+  // row's pose and force fitted without it (a leave-one-out residual).
+  std::vector<SensorReading> left_out_residuals;
+  // The model-fit test of the final fit (when ok): chi-square, its degrees
+  // of freedom and upper-tail probability; true when it failed or the
+  // problem is under-determined (calibration.model_warning says which).
+  double chi_square = 0.0;
+  int degrees_of_freedom = 0;
+  double misfit_probability = 1.0;
+  bool misfit = false;
+  std::vector<FittedEffect> effects;  // in CalibrationOptions::effects order, when ok
+  // Covariance (tangent) of the global variables, in global_keys order:
+  // AnchorKey(i), OffsetKey(i) per cable, then each effect's EffectKey.
+  std::vector<Key> global_keys;
+  Eigen::MatrixXd global_covariance;
+};
+
+// The factor graph of one calibration at its data-driven start, for
+// calibrate() and for benchmarks that must solve exactly the same problem.
+struct BuiltProblem {
+  std::unique_ptr<Problem> problem;   // null when the inputs were refused (see message)
+  // The loss of every reading row (solver/nls/loss.h's shared loss): set it
+  // between solves; least squares (or the Huber of huber_width) when built.
+  std::unique_ptr<LossFunction> reading_loss;
+  // Per pose k: the factor holding its readings (catenary), or the first of
+  // its kCableCount encoder factors (rigid), in problem->factors().
+  std::vector<int> reading_factor;
+  std::vector<Sample> samples;        // the samples in the problem, pose k = samples[k]
+  std::vector<int> rejected_samples;  // ids the model could not be started from
+  std::string message;
+};
+BuiltProblem build_calibration_problem(const Robot& robot, const std::vector<Sample>& samples,
+                                       const CalibrationOptions& options);
+
+// `samples` without the given gross errors: with the catenary model each
+// rejected reading is left out of its row (Sample::encoder_left_out,
+// force_left_out) and the rest of the row is kept; the rigid model has no
+// per-reading mask, so the whole row goes.
+std::vector<Sample> leave_out(const std::vector<Sample>& samples, const std::vector<SensorReading>& gross_errors,
+                              CableModelKind cable_model);
+
+// The robust fit (CalibrationOptions::robust), a restart with a looser
+// height consistency when the first fit stops where the anchors are
+// unobservable, the rows of gross errors left out and the fit redone, and
+// the model-fit test. Refuses (ok = false) when more than
+// max_rejected_fraction of the rows have gross errors.
+CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& samples,
+                            const CalibrationOptions& options);
+
+}  // namespace cdpr

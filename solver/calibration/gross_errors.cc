@@ -1,0 +1,50 @@
+#include "solver/calibration/gross_errors.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace cdpr {
+namespace {
+
+// 1.4826 median |r| over the readings of one kind, at least 1.
+double robust_spread(const std::vector<ReadingResidual>& residuals, SensorKind kind) {
+  std::vector<double> sizes;
+  for (const ReadingResidual& r : residuals) {
+    if (r.sensor == kind) sizes.push_back(std::abs(r.whitened));
+  }
+  if (sizes.empty()) return 1.0;
+  const auto middle = sizes.begin() + static_cast<std::ptrdiff_t>(sizes.size() / 2);
+  std::nth_element(sizes.begin(), middle, sizes.end());
+  return std::max(1.0, 1.4826 * *middle);
+}
+
+std::vector<SensorReading> normalised(const std::vector<ReadingResidual>& residuals) {
+  const ReadingSpreads spreads = reading_spreads(residuals);
+  std::vector<SensorReading> out;
+  for (const ReadingResidual& r : residuals) out.push_back({r.row, r.sensor, r.cable, r.whitened / spreads.of(r.sensor)});
+  return out;
+}
+
+}  // namespace
+
+ReadingSpreads reading_spreads(const std::vector<ReadingResidual>& residuals) {
+  return {robust_spread(residuals, SensorKind::kEncoder), robust_spread(residuals, SensorKind::kForce)};
+}
+
+std::vector<SensorReading> gross_errors(const std::vector<ReadingResidual>& residuals, double threshold_sigma) {
+  std::vector<SensorReading> flagged;
+  for (const SensorReading& r : normalised(residuals)) {
+    if (std::abs(r.value) > threshold_sigma) flagged.push_back(r);
+  }
+  std::sort(flagged.begin(), flagged.end(),
+            [](const SensorReading& a, const SensorReading& b) { return std::abs(a.value) > std::abs(b.value); });
+  return flagged;
+}
+
+double largest_normalised_residual(const std::vector<ReadingResidual>& residuals) {
+  double largest = 0.0;
+  for (const SensorReading& r : normalised(residuals)) largest = std::max(largest, std::abs(r.value));
+  return largest;
+}
+
+}  // namespace cdpr

@@ -1,0 +1,47 @@
+#pragma once
+// Which sensor readings of a fitted calibration are gross errors (a slipped
+// cable, a bus glitch, a platform not yet at rest): the test that decides
+// rejection after the robust fit (solver/calibration/calibrate.h).
+//
+// Each reading's whitened residual (residual / the sensor's sigma of
+// robot.toml) is divided by the spread of all readings of its kind (encoder
+// or load cell): 1.4826 times their median absolute value, a spread that a
+// minority of gross errors does not move, taken as 1 when it is smaller
+// (the sigmas of robot.toml are the floor: a fit's residuals are a little
+// smaller than the noise). A reading is a gross error when that normalised
+// residual exceeds the threshold: noise with the right sigma exceeds 5 once
+// in 1.7 million readings, so clean rows are practically never rejected,
+// while data noisier than robot.toml says (or a model that does not fit
+// everywhere) raises the spread and the bar with it rather than rejecting
+// whole swathes of rows.
+
+#include <vector>
+
+#include "solver/model/calibration.h"
+#include "solver/nls/problem.h"
+
+namespace cdpr {
+
+// One reading's whitened residual at the current values of a problem.
+struct ReadingResidual {
+  int row = 0;  // sample id
+  SensorKind sensor = SensorKind::kEncoder;
+  int cable = 0;
+  double whitened = 0.0;
+};
+
+// The robust spread of each kind, by which residuals are normalised.
+struct ReadingSpreads {
+  double encoder = 1.0, force = 1.0;
+  double of(SensorKind kind) const { return kind == SensorKind::kEncoder ? encoder : force; }
+};
+ReadingSpreads reading_spreads(const std::vector<ReadingResidual>& residuals);
+
+// Readings whose normalised residual exceeds threshold_sigma, each with that
+// normalised residual as its value; worst first.
+std::vector<SensorReading> gross_errors(const std::vector<ReadingResidual>& residuals, double threshold_sigma);
+
+// The largest normalised residual (0 when there are none).
+double largest_normalised_residual(const std::vector<ReadingResidual>& residuals);
+
+}  // namespace cdpr

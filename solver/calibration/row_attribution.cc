@@ -1,0 +1,190 @@
+#include "solver/calibration/row_attribution.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Cholesky>
+
+#include "solver/nls/factor_parameters.h"
+
+namespace cdpr {
+namespace {
+
+// The row's own variables (pose, reference force) free, every other one a
+// constant copy of the problem's.
+struct LocalProblem {
+  Problem problem;
+  std::vector<int> free;  // variable indices in `problem`
+  int columns = 0;
+};
+
+LocalProblem local_problem(const Problem& full, const std::vector<int>& row_factors, int pose_index) {
+  LocalProblem local;
+  for (int f : row_factors) {
+    for (const Key& key : full.factors()[f]->keys()) {
+      if (local.problem.has(key)) continue;
+      const bool own = key == PoseKey(pose_index) || key == ReferenceForceKey(pose_index);
+      if (key == PoseKey(pose_index)) {
+        local.problem.add_pose(key, full.pose(key));
+      } else {
+        local.problem.add_vector(key, full.vector(key));
+      }
+      if (own) {
+        local.free.push_back(local.problem.variable_index(key));
+      } else {
+        local.problem.set_constant(key);
+      }
+    }
+  }
+  for (int v : local.free) local.columns += local.problem.variables()[v].tangent_dim;
+  return local;
+}
+
+struct Linearised {
+  bool ok = false;
+  Eigen::VectorXd residual;
+  Eigen::MatrixXd jacobian;  // residual rows x free columns
+};
+
+// (factor, residual row) pairs left out of a refit.
+using LeftOut = std::vector<std::pair<int, int>>;
+
+// Residuals and Jacobian of the row's factors, the left-out rows zeroed.
+Linearised linearise(const Problem& full, const LocalProblem& local, const std::vector<int>& row_factors,
+                     const LeftOut& left_out) {
+  int rows = 0;
+  for (int f : row_factors) rows += full.factors()[f]->residual_dim();
+  Linearised lin;
+  lin.residual = Eigen::VectorXd::Zero(rows);
+  lin.jacobian = Eigen::MatrixXd::Zero(rows, local.columns);
+  int first_row = 0;
+  for (int f : row_factors) {
+    const Factor& factor = *full.factors()[f];
+    const int dim = factor.residual_dim();
+    std::vector<std::vector<double>> blocks(factor.keys().size());
+    std::vector<double*> jacobians(factor.keys().size(), nullptr);
+    std::vector<int> block_column(factor.keys().size(), -1);
+    for (std::size_t b = 0; b < factor.keys().size(); ++b) {
+      const int v = local.problem.variable_index(factor.keys()[b]);
+      int column = 0;
+      for (int free : local.free) {
+        if (free == v) block_column[b] = column;
+        column += local.problem.variables()[free].tangent_dim;
+      }
+      if (block_column[b] < 0) continue;
+      blocks[b].assign(static_cast<std::size_t>(dim) * local.problem.variables()[v].tangent_dim, 0.0);
+      jacobians[b] = blocks[b].data();
+    }
+    std::vector<double> residual(dim, 0.0);
+    double cost = 0.0;
+    if (!factor.evaluate(parameter_blocks(local.problem, factor).data(), residual.data(), jacobians.data(), &cost)) {
+      return lin;
+    }
+    for (int j = 0; j < dim; ++j) {
+      if (std::find(left_out.begin(), left_out.end(), std::pair{f, j}) != left_out.end()) continue;
+      lin.residual(first_row + j) = residual[j];
+      for (std::size_t b = 0; b < blocks.size(); ++b) {
+        if (block_column[b] < 0) continue;
+        const int width = static_cast<int>(blocks[b].size()) / dim;
+        for (int c = 0; c < width; ++c) lin.jacobian(first_row + j, block_column[b] + c) = blocks[b][j * width + c];
+      }
+    }
+    first_row += dim;
+  }
+  lin.ok = true;
+  return lin;
+}
+
+double row_residual(const Problem& full, const LocalProblem& local, int factor_index, int row) {
+  const Factor& factor = *full.factors()[factor_index];
+  std::vector<double> residual(factor.residual_dim(), 0.0);
+  double cost = 0.0;
+  if (!factor.evaluate(parameter_blocks(local.problem, factor).data(), residual.data(), nullptr, &cost)) {
+    return std::numeric_limits<double>::infinity();
+  }
+  return residual[row];
+}
+
+void apply_step(LocalProblem& local, const Eigen::VectorXd& step) {
+  int column = 0;
+  for (int v : local.free) {
+    local.problem.retract(v, step.data() + column);
+    column += local.problem.variables()[v].tangent_dim;
+  }
+}
+
+// Damped Gauss-Newton on the row's own variables without one reading;
+// returns the chi-square of the rest (infinity when it cannot be evaluated).
+double refit_without(const Problem& full, LocalProblem& local, const std::vector<int>& row_factors,
+                     const LeftOut& left_out) {
+  constexpr int kMaxIterations = 30;
+  Linearised lin = linearise(full, local, row_factors, left_out);
+  if (!lin.ok) return std::numeric_limits<double>::infinity();
+  double chi2 = lin.residual.squaredNorm();
+  double damping = 1e-6;
+  for (int it = 0; it < kMaxIterations && damping < 1e12; ++it) {
+    Eigen::MatrixXd normal = lin.jacobian.transpose() * lin.jacobian;
+    normal.diagonal() += damping * normal.diagonal().cwiseMax(1e-9);
+    const Eigen::VectorXd step = normal.ldlt().solve(-lin.jacobian.transpose() * lin.residual);
+    const std::vector<double> saved = local.problem.state();
+    apply_step(local, step);
+    const Linearised next = linearise(full, local, row_factors, left_out);
+    const double next_chi2 = next.ok ? next.residual.squaredNorm() : std::numeric_limits<double>::infinity();
+    if (next_chi2 < chi2) {
+      const bool converged = chi2 - next_chi2 < 1e-10 * chi2;
+      lin = next;
+      chi2 = next_chi2;
+      damping = std::max(damping / 10.0, 1e-12);
+      if (converged) break;
+    } else {
+      local.problem.state() = saved;
+      damping *= 10.0;
+    }
+  }
+  return chi2;
+}
+
+}  // namespace
+
+std::vector<SensorReading> attribute_row(const Problem& problem, int row_id, int pose_index,
+                                         const std::vector<int>& row_factors, const std::vector<RowReading>& readings,
+                                         double threshold_sigma) {
+  // Greedy: leave out the reading whose removal explains the row best, and
+  // another while a reading still stands out (a row may hold two gross
+  // errors, e.g. a slipped cable and a load-cell spike); at least one
+  // reading always stays in.
+  std::vector<int> left_out;  // indices into readings
+  std::vector<double> residuals(readings.size(), 0.0);
+  while (left_out.size() + 1 < readings.size()) {
+    double best_chi2 = std::numeric_limits<double>::infinity();
+    int best = -1;
+    for (std::size_t j = 0; j < readings.size(); ++j) {
+      if (std::find(left_out.begin(), left_out.end(), static_cast<int>(j)) != left_out.end()) continue;
+      LeftOut pairs;
+      for (int o : left_out) pairs.emplace_back(readings[o].factor, readings[o].residual_row);
+      pairs.emplace_back(readings[j].factor, readings[j].residual_row);
+      LocalProblem local = local_problem(problem, row_factors, pose_index);
+      const double chi2 = refit_without(problem, local, row_factors, pairs);
+      if (!(chi2 < best_chi2)) continue;
+      best_chi2 = chi2;
+      best = static_cast<int>(j);
+      for (std::size_t r = 0; r < readings.size(); ++r) {
+        residuals[r] = row_residual(problem, local, readings[r].factor, readings[r].residual_row) / readings[r].spread;
+      }
+    }
+    if (best < 0) break;
+    left_out.push_back(best);
+    bool another = false;
+    for (std::size_t r = 0; r < readings.size(); ++r) {
+      const bool out = std::find(left_out.begin(), left_out.end(), static_cast<int>(r)) != left_out.end();
+      another = another || (!out && std::abs(residuals[r]) > threshold_sigma);
+    }
+    if (!another) break;
+  }
+  std::vector<SensorReading> out;
+  for (int j : left_out) out.push_back({row_id, readings[j].sensor, readings[j].cable, residuals[j]});
+  return out;
+}
+
+}  // namespace cdpr

@@ -1,0 +1,37 @@
+#pragma once
+// Which reading of a row is the gross error. A robust fit can spread one
+// gross encoder error over its row: the row's own pose and reference force
+// move (a Cauchy loss makes two moderate residuals cheaper than one large
+// one), so the largest residual may sit on the load cell or another cable.
+// Leave-one-out decides instead: the row's pose and force are refitted
+// (Gauss-Newton, everything global held) without each of its readings in
+// turn; the reading whose removal leaves the smallest chi-square of the
+// rest is the gross error, its residual that refit's prediction minus the
+// reading. While another reading still stands out in that refit, the one
+// whose removal (with the first) explains the rest best is left out too.
+
+#include <vector>
+
+#include "solver/model/calibration.h"
+#include "solver/nls/problem.h"
+
+namespace cdpr {
+
+// One reading of a row: its factor in the problem, the residual row in it.
+struct RowReading {
+  int factor = 0;
+  int residual_row = 0;
+  SensorKind sensor = SensorKind::kEncoder;
+  int cable = 0;
+  double spread = 1.0;  // robust spread of its kind (solver/calibration/gross_errors.h)
+};
+
+// `row_factors`: every factor of the row (pose prior and readings), whose
+// variables are the row's pose (PoseKey), optionally its ReferenceForceKey,
+// and global ones held at their values in `problem`. Factors are evaluated
+// as they are (their loss must be least squares while this runs).
+std::vector<SensorReading> attribute_row(const Problem& problem, int row_id, int pose_index,
+                                         const std::vector<int>& row_factors, const std::vector<RowReading>& readings,
+                                         double threshold_sigma);
+
+}  // namespace cdpr

@@ -1,0 +1,115 @@
+#include "solver/linalg/dense_kernels_avx2.h"
+
+#include <algorithm>
+#include <cstring>
+
+namespace cdpr::avx2 {
+namespace {
+
+// Four doubles in one register. The helpers below mirror dense_kernels.cc's
+// on purpose, not shared through a header: an inline function compiled here
+// (with -mavx2) and there may be merged by the linker into one copy, which
+// could then be this file's AVX code run on a processor without AVX2.
+typedef double Quad __attribute__((vector_size(4 * sizeof(double))));
+
+Quad load(const double* p) {
+  Quad v;
+  std::memcpy(&v, p, sizeof v);  // unaligned: rows start anywhere
+  return v;
+}
+void store(double* p, Quad v) { std::memcpy(p, &v, sizeof v); }
+Quad splat(double a) { return Quad{a, a, a, a}; }
+
+// Rows [0, 8) x columns [0, 4) of the block at x, y, out: two quads of x
+// rows times one broadcast y entry per column, 32 multiply-adds a depth step
+// with all eight sums in registers (named, not an array: GCC at -O2 keeps
+// arrays of vectors in memory).
+void tile8x4(int depth, const double* x, int ldx, const double* y, int ldy, double* out, int ldo, double sign) {
+  Quad a0 = {}, a1 = {}, a2 = {}, a3 = {}, b0 = {}, b1 = {}, b2 = {}, b3 = {};
+  for (int k = 0; k < depth; ++k) {
+    const double* xk = x + k * ldx;
+    const double* yk = y + k * ldy;
+    const Quad x0 = load(xk), x1 = load(xk + 4);
+    const Quad y0 = splat(yk[0]), y1 = splat(yk[1]), y2 = splat(yk[2]), y3 = splat(yk[3]);
+    a0 += x0 * y0;
+    b0 += x1 * y0;
+    a1 += x0 * y1;
+    b1 += x1 * y1;
+    a2 += x0 * y2;
+    b2 += x1 * y2;
+    a3 += x0 * y3;
+    b3 += x1 * y3;
+  }
+  const Quad s = splat(sign);
+  auto add = [&](int q, Quad top, Quad bottom) {
+    double* o = out + ldo * q;
+    store(o, load(o) + s * top);
+    store(o + 4, load(o + 4) + s * bottom);
+  };
+  add(0, a0, b0);
+  add(1, a1, b1);
+  add(2, a2, b2);
+  add(3, a3, b3);
+}
+
+// Rows [0, 4) x columns [0, Cols), Cols <= 4 (named sums, as above).
+template <int Cols>
+void tile4(int depth, const double* x, int ldx, const double* y, int ldy, double* out, int ldo, double sign) {
+  Quad a0 = {}, a1 = {}, a2 = {}, a3 = {};
+  for (int k = 0; k < depth; ++k) {
+    const Quad xv = load(x + k * ldx);
+    const double* yk = y + k * ldy;
+    a0 += xv * splat(yk[0]);
+    if constexpr (Cols > 1) a1 += xv * splat(yk[1]);
+    if constexpr (Cols > 2) a2 += xv * splat(yk[2]);
+    if constexpr (Cols > 3) a3 += xv * splat(yk[3]);
+  }
+  const Quad s = splat(sign);
+  store(out, load(out) + s * a0);
+  if constexpr (Cols > 1) store(out + ldo, load(out + ldo) + s * a1);
+  if constexpr (Cols > 2) store(out + 2 * ldo, load(out + 2 * ldo) + s * a2);
+  if constexpr (Cols > 3) store(out + 3 * ldo, load(out + 3 * ldo) + s * a3);
+}
+
+// Row 0 alone x columns [0, Cols).
+template <int Cols>
+void row1(int depth, const double* x, int ldx, const double* y, int ldy, double* out, int ldo, double sign) {
+  double sum[Cols] = {};
+  for (int k = 0; k < depth; ++k) {
+    const double xk = x[k * ldx];
+    for (int q = 0; q < Cols; ++q) sum[q] += xk * y[k * ldy + q];
+  }
+  for (int q = 0; q < Cols; ++q) out[ldo * q] += sign * sum[q];
+}
+
+// Rows [0, rows) x columns [0, Cols).
+template <int Cols>
+void columns(int depth, int rows, const double* x, int ldx, const double* y, int ldy, double* out, int ldo,
+             double sign) {
+  int r = 0;
+  if constexpr (Cols == 4) {
+    for (; r + 8 <= rows; r += 8) tile8x4(depth, x + r, ldx, y, ldy, out + r, ldo, sign);
+  }
+  for (; r + 4 <= rows; r += 4) tile4<Cols>(depth, x + r, ldx, y, ldy, out + r, ldo, sign);
+  for (; r < rows; ++r) row1<Cols>(depth, x + r, ldx, y, ldy, out + r, ldo, sign);
+}
+
+}  // namespace
+
+void add_transposed_product(int depth, int rows, int cols, const double* x, int ldx, const double* y, int ldy,
+                            double* out, int ldo, double sign, bool upper) {
+  int c = 0;
+  for (; c + 4 <= cols; c += 4) {
+    columns<4>(depth, upper ? std::min(rows, c + 4) : rows, x, ldx, y + c, ldy, out + ldo * c, ldo, sign);
+  }
+  const int rest = cols - c, row_end = upper ? std::min(rows, cols) : rows;
+  y += c;
+  out += ldo * c;
+  switch (rest) {
+    case 3: return columns<3>(depth, row_end, x, ldx, y, ldy, out, ldo, sign);
+    case 2: return columns<2>(depth, row_end, x, ldx, y, ldy, out, ldo, sign);
+    case 1: return columns<1>(depth, row_end, x, ldx, y, ldy, out, ldo, sign);
+  }
+}
+
+}  // namespace cdpr::avx2

@@ -1,0 +1,259 @@
+#include "solver/model/initial_guess.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "solver/model/catenary.h"
+#include "solver/model/platform_statics.h"
+#include "solver/nls/trust_region_strategy.h"
+
+namespace cdpr {
+
+Eigen::Vector2d paper_reference_force_guess(const Robot& robot, const std::array<Eigen::Vector3d, kCableCount>& anchors,
+                                            const Sample& sample) {
+  const int ref = robot.reference_cable;
+  const Eigen::Vector3d attachment_world =
+      sample.world_R_platform * robot.winches[ref].attachment_platform + sample.position_world;
+  const Eigen::Vector3d chord = attachment_world - anchors[ref];
+  const double horizontal = std::hypot(chord.x(), chord.y());
+  const double f_v0 = robot.platform_mass_kg * robot.gravity_mps2 / 4.0;  // Eq. (17)
+  // Eq. (18): cos(alpha) = s_c^T chord / |chord| = horizontal / |chord|.
+  const double alpha = std::acos(std::min(1.0, horizontal / chord.norm()));
+  return {f_v0 / std::tan(alpha), f_v0};
+}
+
+Eigen::Vector2d rigid_reference_force_guess(const Robot& robot, const std::array<Eigen::Vector3d, kCableCount>& anchors,
+                                            const Sample& sample) {
+  Eigen::Matrix<double, 6, kCableCount> wrench_per_tension;
+  Eigen::Matrix<double, 3, kCableCount> directions;
+  for (int i = 0; i < kCableCount; ++i) {
+    const Eigen::Vector3d lever = sample.world_R_platform * robot.winches[i].attachment_platform;
+    directions.col(i) = (anchors[i] - (sample.position_world + lever)).normalized();
+    wrench_per_tension.col(i) << directions.col(i), lever.cross(directions.col(i));
+  }
+  const double weight = robot.platform_mass_kg * robot.gravity_mps2;
+  Eigen::Matrix<double, 6, 1> wrench;
+  wrench << 0.0, 0.0, weight, (sample.world_R_platform * robot.center_of_mass_platform).cross(Eigen::Vector3d(0, 0, weight));
+  const Eigen::Vector4d tensions = wrench_per_tension.colPivHouseholderQr().solve(wrench);
+  const Eigen::Vector3d u = directions.col(robot.reference_cable);
+  const double tension = std::max(tensions(robot.reference_cable), 0.25 * weight);
+  return {tension * std::hypot(u.x(), u.y()), tension * u.z()};
+}
+
+namespace {
+
+constexpr int kFitRows = kCableCount + 1;  // Eq. (15) per cable, Eq. (16)
+using FitResiduals = Eigen::Matrix<double, kFitRows, 1>;
+using FitJacobian = Eigen::Matrix<double, kFitRows, 2>;
+
+// The height (Eq. 15) and force (Eq. 16) residuals of StaticPoseFactor at
+// one pose, whitened, as functions of the reference force alone through the
+// statics' affine map, and (when `jacobian`) their derivatives. False where
+// a cable would push: outside the model.
+bool height_and_force(const Robot& robot, const ReferenceForceMap& map, const Sample& sample,
+                      const Eigen::Vector2d& force, double sigma_height_m, FitResiduals& residual,
+                      FitJacobian* jacobian) {
+  const double weight_per_length = robot.gravity_mps2 * robot.cable_linear_density_kgpm;
+  for (int i = 0; i < kCableCount; ++i) {
+    const Eigen::Vector2d f = map.offset[i] + map.gain[i] * force;
+    if (!(f.x() > 0.0)) return false;
+    const CatenaryOutput shape =
+        evaluate_catenary({f.x(), f.y(), map.span[i], map.anchor_z[i], weight_per_length}, jacobian != nullptr);
+    residual(i) = (map.attachment_z[i] - shape.end_height) / sigma_height_m;
+    if (jacobian) {
+      jacobian->row(i) =
+          -(shape.d_end_height(0) * map.gain[i].row(0) + shape.d_end_height(1) * map.gain[i].row(1)) / sigma_height_m;
+    }
+  }
+  const double tension = force.norm();
+  const double sigma_force = robot.noise.force_n;
+  residual(kCableCount) = (tension - sample.force_n) / sigma_force;
+  if (jacobian) {
+    jacobian->row(kCableCount).setZero();
+    if (tension > 0.0) jacobian->row(kCableCount) = force.transpose() / (tension * sigma_force);
+  }
+  return true;
+}
+
+std::optional<ReferenceForceMap> force_map(const Robot& robot, const std::array<Eigen::Vector3d, kCableCount>& anchors,
+                                           const Sample& sample) {
+  StaticsInput in;
+  in.world_T_platform = Pose{sample.position_world, sample.world_R_platform};
+  in.anchor_world = anchors;
+  ReferenceForceMap map;
+  if (reference_force_map(robot, in, map) != StaticsStatus::kOk) return std::nullopt;
+  return map;
+}
+
+// Levenberg-Marquardt on the fit's residuals over N unknowns x, its steps
+// judged and its damping set by the solver's TrustRegionStrategy: a trial
+// minimises the model with the normal matrix's diagonal scaled by
+// 1 + 1/radius. It stops when a step gains less than kStopGain of the cost,
+// and, without evaluating, once the model predicts no more than that: near
+// the minimum rounding would refuse trial after trial. At most 50 trials.
+//
+// `evaluate(x, residual, jacobian)` is false outside the model;
+// `propose(x, H, g)` gives the trial point from the damped normal matrix H
+// and gradient g. False when the start x cannot be evaluated; else x is the
+// best point found.
+// A start needs its forces and heading near their minimum, not at it: the
+// calibration refines them with everything else, and with the anchors
+// metres off Gauss-Newton converges only linearly here, so the stop is
+// loose (the calibration's result does not depend on the digits beyond it).
+constexpr double kStopGain = 1e-7;
+
+// Damping 1e-3 at the start, never below 1e-9, given up above 1e12.
+constexpr TrustRegionOptions kStartTrustRegion{1e3, 1e9, 1e-12};
+
+template <int N, typename Evaluate, typename Propose>
+bool damped_gauss_newton(Eigen::Matrix<double, N, 1>& x, const Evaluate& evaluate, const Propose& propose) {
+  using Vector = Eigen::Matrix<double, N, 1>;
+  using Jacobian = Eigen::Matrix<double, kFitRows, N>;
+  FitResiduals residual, trial_residual;
+  Jacobian jacobian, trial_jacobian;
+  if (!evaluate(x, residual, jacobian)) return false;
+  double cost = residual.squaredNorm();
+  TrustRegionStrategy strategy(kStartTrustRegion);
+  for (int iteration = 0; iteration < 50 && !strategy.collapsed(); ++iteration) {
+    const Vector gradient = jacobian.transpose() * residual;
+    const Eigen::Matrix<double, N, N> jtj = jacobian.transpose() * jacobian;
+    Eigen::Matrix<double, N, N> H = jtj;
+    H.diagonal() *= 1.0 + strategy.damping();
+    const Vector trial = propose(x, H, gradient);
+    const Vector step = trial - x;
+    // The cost is |r|^2: the undamped model's decrease is -(2 g's + s'J'Js).
+    const double predicted = -(2.0 * gradient.dot(step) + step.dot(jtj * step));
+    if (!(predicted > kStopGain * (1.0 + cost))) break;
+    const double trial_cost = evaluate(trial, trial_residual, trial_jacobian)
+                                  ? trial_residual.squaredNorm()
+                                  : std::numeric_limits<double>::quiet_NaN();
+    if (strategy.judge_step(cost, trial_cost, predicted)) {
+      const bool converged = cost - trial_cost < kStopGain * (1.0 + cost);
+      x = trial;
+      residual = trial_residual;
+      jacobian = trial_jacobian;
+      cost = trial_cost;
+      if (converged) break;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+std::optional<Eigen::Vector2d> refine_reference_force(const Robot& robot,
+                                                      const std::array<Eigen::Vector3d, kCableCount>& anchors,
+                                                      const Sample& sample, const Eigen::Vector2d& guess,
+                                                      double sigma_height_m) {
+  // Only the height and force rows constrain the force; encoder rows carry
+  // the still unknown offsets. The pose and anchors are fixed, so the
+  // statics are factorised once and each trial costs four catenaries.
+  const std::optional<ReferenceForceMap> map = force_map(robot, anchors, sample);
+  if (!map) return std::nullopt;
+  auto evaluate = [&](const Eigen::Vector2d& force, FitResiduals& residual, FitJacobian& jacobian) {
+    return height_and_force(robot, *map, sample, force, sigma_height_m, residual, &jacobian);
+  };
+  Eigen::Vector2d force = guess;
+  const bool evaluable = damped_gauss_newton<2>(
+      force, evaluate, [](const Eigen::Vector2d& x, const Eigen::Matrix2d& H, const Eigen::Vector2d& gradient) {
+        return Eigen::Vector2d(x - H.ldlt().solve(gradient));
+      });
+  if (!evaluable) return std::nullopt;
+  return force;
+}
+
+std::optional<Eigen::Vector2d> search_feasible_reference_force(const Robot& robot,
+                                                               const std::array<Eigen::Vector3d, kCableCount>& anchors,
+                                                               const Sample& sample, double sigma_height_m) {
+  const std::optional<ReferenceForceMap> map = force_map(robot, anchors, sample);
+  if (!map) return std::nullopt;
+  FitResiduals residual;
+  // A suspended platform's cables each carry at most a few times its weight.
+  const double weight = robot.platform_mass_kg * robot.gravity_mps2;
+  constexpr int kSteps = 60;
+  std::optional<Eigen::Vector2d> best;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (int a = 1; a <= kSteps; ++a) {
+    for (int b = 0; b <= kSteps; ++b) {
+      const Eigen::Vector2d force(4.0 * weight * a / kSteps, weight * (-1.0 + 3.0 * b / kSteps));
+      if (!height_and_force(robot, *map, sample, force, sigma_height_m, residual, nullptr)) continue;
+      const double cost = residual.squaredNorm();
+      if (cost < best_cost) {
+        best_cost = cost;
+        best = force;
+      }
+    }
+  }
+  return best;
+}
+
+std::optional<ForceAndHeading> refine_reference_force_and_heading(
+    const Robot& robot, const std::array<Eigen::Vector3d, kCableCount>& anchors, const Sample& sample,
+    const Eigen::Vector2d& guess, double yaw_guess_rad, double yaw_min_rad, double yaw_max_rad, double sigma_height_m) {
+  using Jacobian3 = Eigen::Matrix<double, kFitRows, 3>;
+  const double weight_per_length = robot.gravity_mps2 * robot.cable_linear_density_kgpm;
+  const double sigma_force = robot.noise.force_n;
+  // Residuals and their Jacobian in (f_h, f_v, yaw) at one point: the
+  // statics factorised at that heading, each catenary evaluated once.
+  auto evaluate = [&](const Eigen::Vector2d& force, double yaw, FitResiduals& residual, Jacobian3& jacobian) {
+    Sample turned = sample;
+    turned.world_R_platform = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())) * sample.world_R_platform;
+    const std::optional<ReferenceForceMap> map = force_map(robot, anchors, turned);
+    if (!map) return false;
+    std::array<Eigen::Vector2d, kCableCount> f;
+    for (int i = 0; i < kCableCount; ++i) {
+      f[i] = map->offset[i] + map->gain[i] * force;
+      if (!(f[i].x() > 0.0)) return false;
+    }
+    const std::array<Eigen::Vector2d, kCableCount> d_yaw = map->d_force_d_yaw(force);
+    for (int i = 0; i < kCableCount; ++i) {
+      const CatenaryOutput shape =
+          evaluate_catenary({f[i].x(), f[i].y(), map->span[i], map->anchor_z[i], weight_per_length}, true);
+      residual(i) = (map->attachment_z[i] - shape.end_height) / sigma_height_m;
+      jacobian.block<1, 2>(i, 0) =
+          -(shape.d_end_height(0) * map->gain[i].row(0) + shape.d_end_height(1) * map->gain[i].row(1)) / sigma_height_m;
+      jacobian(i, 2) = -(shape.d_end_height(0) * d_yaw[i].x() + shape.d_end_height(1) * d_yaw[i].y() +
+                         shape.d_end_height(2) * map->d_span_d_yaw[i]) /
+                       sigma_height_m;
+    }
+    const double tension = force.norm();
+    residual(kCableCount) = (tension - sample.force_n) / sigma_force;
+    jacobian.row(kCableCount).setZero();
+    if (tension > 0.0) jacobian.block<1, 2>(kCableCount, 0) = force.transpose() / (tension * sigma_force);
+    return true;
+  };
+  // The unknowns as one vector (f_h, f_v, yaw).
+  auto evaluate_at = [&](const Eigen::Vector3d& x, FitResiduals& residual, Jacobian3& jacobian) {
+    return evaluate(x.head<2>(), x(2), residual, jacobian);
+  };
+  Eigen::Vector3d x(guess.x(), guess.y(), std::clamp(yaw_guess_rad, yaw_min_rad, yaw_max_rad));
+  auto propose = [&](const Eigen::Vector3d& current, const Eigen::Matrix3d& H, const Eigen::Vector3d& gradient) {
+    Eigen::Vector3d step = -H.ldlt().solve(gradient);
+    const double yaw = current(2);
+    // A step that would cross a bound stops the heading on it, and the forces
+    // take the model's best step for that turn: the minimum of the quadratic
+    // model with the heading fixed (clamping the heading alone kept forces
+    // fitted to a far larger turn).
+    const double bounded = std::clamp(yaw + step(2), yaw_min_rad, yaw_max_rad);
+    if (bounded != yaw + step(2)) {
+      step(2) = bounded - yaw;
+      step.head<2>() = -H.topLeftCorner<2, 2>().ldlt().solve(gradient.head<2>() + H.block<2, 1>(0, 2) * step(2));
+    }
+    return Eigen::Vector3d(current(0) + step(0), current(1) + step(1), bounded);
+  };
+  if (!damped_gauss_newton<3>(x, evaluate_at, propose)) return std::nullopt;
+  return ForceAndHeading{x.head<2>(), x(2)};
+}
+
+std::array<double, kCableCount> mean_offsets(const std::vector<Sample>& samples,
+                                             const std::vector<std::array<double, kCableCount>>& lengths) {
+  std::array<double, kCableCount> offsets{};
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    for (int i = 0; i < kCableCount; ++i) offsets[i] += samples[k].encoder_m[i] - lengths[k][i];
+  }
+  for (double& offset : offsets) offset /= static_cast<double>(samples.size());
+  return offsets;
+}
+
+}  // namespace cdpr

@@ -1,0 +1,132 @@
+// The robust calibration on simulated data: gross errors found, named and
+// left out; clean data fitted exactly as by least squares; too many gross
+// errors refused; a model that does not fit, or too few poses, said so.
+#include <algorithm>
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "sim/dataset.h"
+#include "solver/calibration/calibrate.h"
+
+namespace cdpr {
+namespace {
+
+sim::SimulatedDataset simulate(sim::DatasetConfig config) {
+  config.segments = 400;
+  auto data = sim::simulate_dataset(config);
+  EXPECT_TRUE(data) << (data ? "" : data.error());
+  return data ? std::move(*data) : sim::SimulatedDataset{};
+}
+
+sim::DatasetConfig large(int poses, std::uint64_t seed) {
+  sim::DatasetConfig c;
+  c.pose_count = poses;
+  c.seed = seed;
+  c.anchor_perturbation_m = 10.0;
+  return c;
+}
+
+double mean_anchor_error(const Calibration& cal, const Truth& truth) {
+  double sum = 0.0;
+  for (int i = 0; i < kCableCount; ++i) sum += (cal.winches[i].anchor_world - truth.winches[i].anchor_world).norm();
+  return sum / kCableCount;
+}
+
+TEST(RobustCalibration, PlantedGrossErrorsAreRejectedAndNamed) {
+  // GIVEN 35 poses, nominal anchors 10 m off, 10 % rows with a 0.5-2 m
+  // encoder error and 5 % with a load-cell spike
+  sim::DatasetConfig config = large(35, 3);
+  config.gross_errors.encoder_fraction = 0.1;
+  config.gross_errors.force_fraction = 0.05;
+  const sim::SimulatedDataset data = simulate(config);
+  ASSERT_EQ(data.truth.outliers.size(), 6u);
+  // WHEN calibrated with default options
+  const CalibrationResult result = calibrate(data.nominal, data.samples, CalibrationOptions{});
+  // THEN it succeeds without those readings, every planted reading named (row,
+  // sensor, cable) at many sigmas, and the anchors as good as on clean data
+  ASSERT_TRUE(result.ok) << result.message;
+  EXPECT_EQ(result.calibration.samples, 35);  // only the readings are left out
+  for (const SensorReading& planted : data.truth.outliers) {
+    const auto hit = std::find_if(result.calibration.rejected.begin(), result.calibration.rejected.end(),
+                                  [&](const SensorReading& r) {
+                                    return r.row == planted.row && r.sensor == planted.sensor && r.cable == planted.cable;
+                                  });
+    ASSERT_NE(hit, result.calibration.rejected.end()) << "row " << planted.row;
+    EXPECT_GT(std::abs(hit->value), 20.0);
+  }
+  EXPECT_LT(mean_anchor_error(result.calibration, data.truth), 0.6);
+  EXPECT_FALSE(result.misfit) << result.calibration.model_warning;
+}
+
+TEST(RobustCalibration, CleanDataGivesTheLeastSquaresFitAndItsSigmas) {
+  // GIVEN effect-free data without gross errors
+  const sim::SimulatedDataset data = simulate(large(35, 5));
+  // WHEN fitted robustly (default) and by least squares alone
+  const CalibrationResult robust = calibrate(data.nominal, data.samples, CalibrationOptions{});
+  CalibrationOptions plain_options;
+  plain_options.robust = false;
+  const CalibrationResult plain = calibrate(data.nominal, data.samples, plain_options);
+  // THEN nothing is rejected and both reach the same minimum with the same sigmas
+  ASSERT_TRUE(robust.ok) << robust.message;
+  ASSERT_TRUE(plain.ok) << plain.message;
+  EXPECT_TRUE(robust.calibration.rejected.empty());
+  EXPECT_NEAR(robust.solver.final_cost, plain.solver.final_cost, 1e-6 * plain.solver.final_cost);
+  for (int i = 0; i < kCableCount; ++i) {
+    const WinchCalibration &r = robust.calibration.winches[i], &p = plain.calibration.winches[i];
+    EXPECT_LT((r.anchor_world - p.anchor_world).norm(), 1e-4);
+    for (int a = 0; a < 3; ++a) EXPECT_NEAR(r.anchor_sigma(a), p.anchor_sigma(a), 1e-3 * p.anchor_sigma(a));
+  }
+  EXPECT_FALSE(robust.misfit) << robust.calibration.model_warning;
+}
+
+TEST(RobustCalibration, TooManyGrossErrorsAreRefusedWithTheReason) {
+  // GIVEN 20 % rows with gross encoder errors, and at most 10 % allowed
+  sim::DatasetConfig config = large(35, 3);
+  config.gross_errors.encoder_fraction = 0.2;
+  const sim::SimulatedDataset data = simulate(config);
+  CalibrationOptions options;
+  options.max_rejected_fraction = 0.1;
+  // WHEN calibrated
+  const CalibrationResult result = calibrate(data.nominal, data.samples, options);
+  // THEN it is refused, naming the fraction, the rows and what to do
+  EXPECT_FALSE(result.ok);
+  EXPECT_NE(result.message.find("need attention"), std::string::npos) << result.message;
+  EXPECT_NE(result.message.find("more than the 10 % allowed"), std::string::npos) << result.message;
+  EXPECT_FALSE(result.gross_errors.empty());
+}
+
+TEST(RobustCalibration, ACentreOfMassErrorIsFlaggedAndItsSigmasScaledUp) {
+  // GIVEN data whose platform centre of mass is 1 m off the nominal one
+  sim::DatasetConfig config = large(90, 1);
+  config.effects.com_offset_platform = Eigen::Vector3d(0.0, 0.0, 1.0);
+  const sim::SimulatedDataset data = simulate(config);
+  CalibrationOptions options;
+  const CalibrationResult result = calibrate(data.nominal, data.samples, options);
+  // THEN the fit says the model does not fit, with the evidence and where to go
+  ASSERT_TRUE(result.ok) << result.message;
+  EXPECT_TRUE(result.misfit);
+  EXPECT_NE(result.calibration.model_warning.find("chi-square"), std::string::npos);
+  EXPECT_NE(result.calibration.model_warning.find("cdpr-calib diagnose"), std::string::npos);
+  // AND the sigmas are those of the covariance times sqrt(chi2 / dof)
+  options.misfit_alpha = 0.0;  // the test off: unscaled sigmas
+  const CalibrationResult unscaled = calibrate(data.nominal, data.samples, options);
+  ASSERT_TRUE(unscaled.ok);
+  EXPECT_FALSE(unscaled.misfit);
+  const double scale = std::sqrt(result.chi_square / result.degrees_of_freedom);
+  EXPECT_GT(scale, 1.0);
+  EXPECT_NEAR(result.calibration.winches[0].anchor_sigma.x(), scale * unscaled.calibration.winches[0].anchor_sigma.x(),
+              1e-9);
+}
+
+TEST(RobustCalibration, ThreePosesAreUnderDetermined) {
+  const sim::SimulatedDataset data = simulate(large(3, 2));
+  const CalibrationResult result = calibrate(data.nominal, data.samples, CalibrationOptions{});
+  ASSERT_TRUE(result.ok) << result.message;
+  EXPECT_TRUE(result.misfit);
+  EXPECT_NE(result.calibration.model_warning.find("under-determined"), std::string::npos)
+      << result.calibration.model_warning;
+}
+
+}  // namespace
+}  // namespace cdpr

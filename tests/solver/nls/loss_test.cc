@@ -1,0 +1,74 @@
+#include "solver/nls/loss.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+namespace cdpr {
+namespace {
+
+TEST(Loss, PlainLeastSquaresWhenWidthNotPositive) {
+  for (double width : {0.0, -1.0}) {
+    // GIVEN no Huber width; THEN cost is r^2/2 and nothing is rescaled
+    const Loss loss{width};
+    for (double r : {-100.0, -0.5, 0.0, 3.0, 1e6}) {
+      EXPECT_DOUBLE_EQ(loss.cost(r), 0.5 * r * r);
+      EXPECT_DOUBLE_EQ(loss.scale(r), 1.0);
+    }
+  }
+}
+
+TEST(Loss, HuberIsQuadraticInsideAndLinearOutside) {
+  // GIVEN width k = 2
+  const Loss loss{2.0};
+  // THEN inside |r| <= k: r^2/2; outside: k|r| - k^2/2, continuous at the width
+  EXPECT_DOUBLE_EQ(loss.cost(1.5), 0.5 * 1.5 * 1.5);
+  EXPECT_DOUBLE_EQ(loss.cost(-2.0), 2.0);
+  EXPECT_DOUBLE_EQ(loss.cost(10.0), 2.0 * 10.0 - 2.0);
+  EXPECT_DOUBLE_EQ(loss.cost(-10.0), 2.0 * 10.0 - 2.0);
+  EXPECT_NEAR(loss.cost(2.0 + 1e-9), loss.cost(2.0), 3e-9);
+}
+
+TEST(Loss, ScaledResidualCarriesTheHuberGradient) {
+  // GIVEN an outlier residual r beyond the width k
+  const Loss loss{1.5};
+  for (double r : {-7.0, 2.0, 40.0}) {
+    // WHEN the solver sees s*r with Jacobian s*J; its gradient (s*r)*(s*J) = s^2 r J
+    const double s = loss.scale(r);
+    // THEN that equals d cost / dr * J (numerically differentiated cost)
+    const double h = 1e-6;
+    const double dcost = (loss.cost(r + h) - loss.cost(r - h)) / (2 * h);
+    EXPECT_NEAR(s * s * r, dcost, 1e-7) << r;
+    EXPECT_LT(s, 1.0);
+  }
+}
+
+TEST(Loss, CauchyRedescendsAndCarriesItsGradient) {
+  // GIVEN a Cauchy loss of width 3
+  const LossFunction cauchy{LossKind::kCauchy, 3.0};
+  for (double r : {-50.0, -2.0, 0.5, 3.0, 400.0}) {
+    // THEN the scaled residual carries d cost / dr (IRLS weight rho')
+    const double s = cauchy.scale(r);
+    const double h = 1e-6;
+    const double dcost = (cauchy.cost(r + h) - cauchy.cost(r - h)) / (2 * h);
+    EXPECT_NEAR(s * s * r, dcost, 1e-6 * std::max(1.0, std::abs(dcost))) << r;
+  }
+  // AND a gross error pulls less the larger it is (redescending influence)
+  EXPECT_LT(std::pow(cauchy.scale(400.0), 2) * 400.0, std::pow(cauchy.scale(40.0), 2) * 40.0);
+  EXPECT_NEAR(cauchy.cost(0.01), 0.5 * 0.01 * 0.01, 1e-9);
+}
+
+TEST(Loss, SharedLossFollowsItsFunction) {
+  // GIVEN a Loss reading a shared function
+  LossFunction function{LossKind::kHuber, 2.0};
+  const Loss loss{0.0, &function};
+  EXPECT_DOUBLE_EQ(loss.cost(10.0), 2.0 * 10.0 - 2.0);
+  // WHEN the function changes between solves THEN the Loss follows it
+  function = LossFunction{};
+  EXPECT_DOUBLE_EQ(loss.cost(10.0), 50.0);
+  EXPECT_DOUBLE_EQ(loss.scale(10.0), 1.0);
+}
+
+}  // namespace
+}  // namespace cdpr
