@@ -192,7 +192,7 @@ Expected<std::vector<Sample>, FormatError> read_samples_csv(const std::string& p
 
 std::string format_samples_csv(const std::vector<Sample>& samples) {
   std::string out =
-      "# samples.csv (FORMATS.md): position [m] world, quaternion platform->world, encoders [m], "
+      "# samples.csv (docs/FORMATS.md): position [m] world, quaternion platform->world, encoders [m], "
       "reference force [N]\n";
   out += joined(column_names(kCableCount)) + "\n";
   for (const Sample& s : samples) {

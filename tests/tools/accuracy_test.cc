@@ -13,7 +13,7 @@ TEST(ModelCheck, CatenaryMatchesSimulatedEquilibriumLikeTableI) {
     // GIVEN the simulator's true equilibria; WHEN the fitting model predicts them
     const ModelCheck c = model_check(preset, 10, 3);
     ASSERT_TRUE(c.error.empty()) << c.error;
-    // THEN lengths agree to better than 0.01 % and forces to better than 1 % (issue 4)
+    // THEN lengths agree to better than 0.01 % and forces to better than 1 %
     EXPECT_LT(c.max_length_error_pct, 0.01);
     EXPECT_LT(c.max_force_error_pct, 1.0);
   }
@@ -62,7 +62,7 @@ TEST(Accuracy, LargeRobotWithWideWaypointsBeatsPaperAndRigidModel) {
     rigid.push_back(run_case(c, seed));
   }
   const Summary cat = summarise(catenary), rig = summarise(rigid);
-  // THEN the catenary fit meets issue 4's 0.10 m (the paper reports 0.19 m), is far better than
+  // THEN the catenary fit meets the 0.10 m target (the paper reports 0.19 m), is far better than
   // the rigid model, and its sigmas are honest
   EXPECT_LE(cat.anchor.mean, 0.10);
   EXPECT_LE(cat.offset.mean, 0.10);

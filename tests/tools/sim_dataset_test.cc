@@ -239,7 +239,7 @@ TEST(SimDataset, OffsetCentreOfMassTiltsThePlatformAndShiftsTheLoad) {
 TEST(SimDataset, NoEffectsMeansEmptyEffectsTableAndEncoderIsArcPlusOffset) {
   // GIVEN no hidden effects, no noise
   const SimulatedDataset data = simulate(noiseless(Preset::kSmall, 3));
-  // THEN truth.toml has no [effects] and enc_i = arc length + offset_i (FORMATS.md)
+  // THEN truth.toml has no [effects] and enc_i = arc length + offset_i (docs/FORMATS.md)
   EXPECT_TRUE(data.truth.effects.empty());
   for (std::size_t k = 0; k < data.samples.size(); ++k) {
     for (int i = 0; i < kCableCount; ++i) {

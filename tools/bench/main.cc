@@ -1,5 +1,5 @@
 // cdpr-bench: our sparse LM against Ceres on the same calibration problem
-// (issue 7). Runs the Google Benchmark suite, median of 5 repetitions unless
+// (docs/benchmarks.md). Runs the Google Benchmark suite, median of 5 repetitions unless
 // the command line says otherwise, then prints a summary table.
 //
 // Peak memory mode, for a separate process per solver:

@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
   app.add_option("--com-offset", args.com_offset, "hidden centre-of-mass offset x,y,z [m, platform frame]");
   app.add_option("--density-error", config.effects.density_error, "hidden cable density error r: true = nominal * (1 + r)")
       ->check(CLI::Range(-0.9, 10.0));
-  app.add_option("--pulley-radius", config.effects.pulley_radius_m, "hidden swivel-pulley radius [m] (DESIGN.md)")
+  app.add_option("--pulley-radius", config.effects.pulley_radius_m, "hidden swivel-pulley radius [m] (docs/DESIGN.md)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--wind", args.wind, "unknown effect: constant force fx,fy,fz [N, world] on the platform at its CoM");
   app.add_option("--workspace", args.workspace,
