@@ -51,6 +51,16 @@ Table<store::StoreOptions> store_table() {
   return t;
 }
 
+Table<HistoryConfig> history_table() {
+  Table<HistoryConfig> t("history");
+  t.number("budget_mb", &HistoryConfig::budget_mb, 200.0, kNonNegative, "MB",
+           "every run's data is kept in history/run-*; beyond this the oldest go, never the current "
+           "calibration's run nor a pending fit's");
+  t.boolean("model_check", &HistoryConfig::model_check, true,
+            "after each solve, check the model on the run's data (cdpr-calib diagnose) and record the verdict");
+  return t;
+}
+
 Table<DaemonConfig> control_table() {
   Table<DaemonConfig> t("control");
   t.string("socket", &DaemonConfig::control_socket, "/run/cdpr-calib/control",
@@ -261,6 +271,7 @@ std::vector<Section> make_sections() {
   std::vector<Section> s;
   s.push_back(bind(top_table(), [](auto& c) -> auto& { return c; }));
   s.push_back(bind(store_table(), [](auto& c) -> auto& { return c.store; }));
+  s.push_back(bind(history_table(), [](auto& c) -> auto& { return c.history; }));
   s.push_back(bind(control_table(), [](auto& c) -> auto& { return c; }));
   s.push_back(bind(loop_table(), [](auto& c) -> auto& { return c; }));
   s.push_back(bind(winches_table(), [](auto& c) -> auto& { return c.winches; }));
