@@ -46,6 +46,11 @@ struct CalibrationStatus {
   hal::TimeUs started_us = -1;        // monotonic start of the last run; -1 never
   hal::TimeUs state_entered_us = -1;  // when the current state was entered
   hal::TimeUs finished_us = -1;       // when the last run ended (done or failed)
+  // The last run's history entry (docs/FORMATS.md "History entry of a run")
+  // as the owner reports it; empty when it keeps none. Its outcome as in
+  // run.toml: "running", "committed", "failed", "aborted"; empty before a run.
+  std::string run_entry;
+  std::string run_outcome;
 
   // Kept across runs (not reset by a start):
   std::vector<std::string> store_problems;  // what the last store check found unreadable

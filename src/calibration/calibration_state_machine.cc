@@ -62,8 +62,13 @@ bool CalibrationStateMachine::request_start(hal::TimeUs now_us) {
   waypoint_index_ = 0;
   samples_.clear();
   solve_result_.reset();
+  fit_validated_ = false;
   monitor_.reset();
   detector_.reset();
+  run_log_ = formats::RunLog{};
+  run_log_.robot = robot_.name;
+  if (utc_now_text_) run_log_.started = utc_now_text_();
+  log_run(now_us, formats::kRunRunning);
   enter(CalibrationState::kPreflight, now_us);
   update_progress();
   return true;
@@ -113,6 +118,7 @@ bool CalibrationStateMachine::request_abort(hal::TimeUs now_us, const std::strin
     return false;
   }
   fail(why, now_us, false);
+  log_run(now_us, formats::kRunAborted);
   return true;
 }
 
@@ -132,6 +138,10 @@ void CalibrationStateMachine::fail(const std::string& reason, hal::TimeUs now_us
   status_.reason += "; previous calibration kept";
   status_.note = (fault ? "fault: " : "") + reason + where;
   status_.finished_us = now_us;
+  if (fault) run_log_.faults.push_back({run_seconds(now_us), reason + where});
+  run_log_.reason = status_.reason;
+  if (utc_now_text_) run_log_.finished = utc_now_text_();
+  log_run(now_us, formats::kRunFailed);
   enter(CalibrationState::kFailed, now_us);
   refresh_store_problems();
 }
@@ -240,6 +250,8 @@ void CalibrationStateMachine::run_plan(hal::TimeUs now_us) {
   plan_ = plan_waypoints(planning_robot, offsets_m, start_world, options_.planner);
   if (!plan_.ok()) return fail("plan: " + plan_.problem, now_us, false);
   status_.waypoint_count = static_cast<int>(plan_.waypoints.size());
+  run_log_.waypoints_planned = status_.waypoint_count;
+  log_run(now_us);
   waypoint_index_ = 0;
   targets_sent_ = false;
   enter(CalibrationState::kMove, now_us);
@@ -293,6 +305,11 @@ void CalibrationStateMachine::run_settle(hal::TimeUs now_us) {
     ++status_.skipped;
     status_.note = "waypoint " + std::to_string(status_.waypoint) + " skipped: no equilibrium within " +
                    seconds(options_.settle_timeout_us) + " (" + status_.detail + ")";
+    run_log_.waypoints.push_back({status_.waypoint, "skipped", run_seconds(now_us), -1,
+                                  "no equilibrium within " + seconds(options_.settle_timeout_us) + " (" +
+                                      status_.detail + ")"});
+    run_log_.skipped = status_.skipped;
+    log_run(now_us);
     next_waypoint(now_us);
   }
 }
@@ -302,6 +319,9 @@ void CalibrationStateMachine::run_sample(hal::TimeUs now_us) {
   sample.id = static_cast<int>(samples_.size());
   samples_.push_back(sample);
   status_.samples = static_cast<int>(samples_.size());
+  run_log_.waypoints.push_back({status_.waypoint, "sampled", run_seconds(now_us), sample.id, ""});
+  run_log_.samples = status_.samples;
+  log_run(now_us);
   next_waypoint(now_us);
 }
 
@@ -353,6 +373,7 @@ void CalibrationStateMachine::run_validate_and_commit(hal::TimeUs now_us) {
     if (calibration.created.empty()) calibration.created = "1970-01-01T00:00:00Z";
     calibration.robot = robot_.name;
     calibration.samples = static_cast<int>(samples_.size());
+    fit_validated_ = true;
     enter(CalibrationState::kCommit, now_us);
     return;
   }
@@ -364,6 +385,10 @@ void CalibrationStateMachine::run_validate_and_commit(hal::TimeUs now_us) {
                    significant(1e3 * calibration.fit.rms_encoder_m, 3) + " mm, rms force " +
                    significant(calibration.fit.rms_force_n, 3) + " N)";
   status_.finished_us = now_us;
+  run_log_.calibration = *committed;
+  run_log_.reason = status_.reason;
+  if (utc_now_text_) run_log_.finished = utc_now_text_();
+  log_run(now_us, formats::kRunCommitted);
   enter(CalibrationState::kDone, now_us);
   refresh_store_problems();
 }
@@ -374,6 +399,15 @@ std::string CalibrationStateMachine::keep_pending(const Calibration& calibration
   if (!kept) return "; keeping the fit in " + pending.dir() + " failed too: " + kept.error().message();
   return "; the fit and its " + std::to_string(samples_.size()) + " samples are kept in " + pending.dir() +
          ": fix the cause, then `calibctl commit`";
+}
+
+double CalibrationStateMachine::run_seconds(hal::TimeUs now_us) const {
+  return 1e-6 * static_cast<double>(now_us - status_.started_us);
+}
+
+void CalibrationStateMachine::log_run(hal::TimeUs now_us, const char* outcome) {
+  run_log_.robot_time_s = run_seconds(now_us);
+  if (outcome) run_log_.outcome = status_.run_outcome = outcome;
 }
 
 void CalibrationStateMachine::update_progress() {

@@ -36,6 +36,10 @@
 //            request; the reason goes to status().reason and, as the latest
 //            remark, to status().note.
 //
+// Every run is logged in run_log() (docs/FORMATS.md "run.toml"): start and
+// end (utc_now_text), robot time, every waypoint sampled or skipped and why,
+// faults and the outcome; the owner keeps it with samples() in the history.
+//
 // While running (preflight .. sample) every step polls the hardware once
 // (HardwareMonitor: winch update, pose update, one load-cell read) and any
 // fault aborts; owns_hardware() says so, and the owner must not poll the
@@ -60,6 +64,7 @@
 #include "src/calibration/fit_validation.h"
 #include "src/calibration/hardware_monitor.h"
 #include "src/calibration/waypoint_planner.h"
+#include "src/formats/run_log_toml.h"
 #include "src/store/calibration_store.h"
 
 namespace cdpr::calibration {
@@ -128,6 +133,15 @@ class CalibrationStateMachine {
   // Reports a run that a previous daemon did not finish (status().interrupted),
   // until the next start.
   void note_interrupted_run(std::string text) { status_.interrupted = std::move(text); }
+  // The owner names the history entry that keeps the current run's data
+  // (status().run_entry); empty when it could not make one.
+  void note_run_entry(std::string path) { status_.run_entry = std::move(path); }
+
+  // The current or last run's log; `run` is the owner's to fill in.
+  const formats::RunLog& run_log() const { return run_log_; }
+  // The fit of the current or last run once validation accepted it, with
+  // created/robot/samples filled in; null before that and after a refusal.
+  const Calibration* validated_fit() const { return fit_validated_ ? &solve_result_->calibration : nullptr; }
 
   const CalibrationStatus& status() const { return status_; }
   const WaypointPlan& plan() const { return plan_; }
@@ -149,6 +163,9 @@ class CalibrationStateMachine {
   // Keeps a fit whose commit failed in <state>/pending; the sentence for the reason.
   std::string keep_pending(const Calibration& calibration) const;
   void update_progress();
+  // run_log_ at now_us: robot time, and the outcome into the status too.
+  void log_run(hal::TimeUs now_us, const char* outcome = nullptr);
+  double run_seconds(hal::TimeUs now_us) const;
 
   const Robot robot_;
   CalibratorDevices devices_;
@@ -167,6 +184,8 @@ class CalibrationStateMachine {
   bool targets_sent_ = false;
   std::vector<Sample> samples_;
   std::optional<CalibrationResult> solve_result_;
+  bool fit_validated_ = false;
+  formats::RunLog run_log_;
 };
 
 }  // namespace cdpr::calibration

@@ -28,7 +28,9 @@ std::string respond(std::string_view request_line, calibration::CalibrationState
       if (!current) {
         return format_error_response("the current calibration is unreadable: " + current.error().message());
       }
-      return format_show_response(*current);
+      std::optional<store::RunEntry> run;
+      if (*current) run = store::RunHistory(store.history_dir()).find_by_calibration((*current)->text);
+      return format_show_response(*current, run);
     }
     case RequestKind::kHistory: {
       const auto history = store.history();

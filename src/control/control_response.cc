@@ -105,10 +105,20 @@ std::string format_status_response(const calibration::CalibrationStatus& status,
   json["interrupted"] = status.interrupted;
   json["store_problems"] = string_array(status.store_problems);
   json["pending_commit"] = status.pending_commit;
+  if (status.run_outcome.empty()) {
+    json["run"] = nullptr;
+  } else {
+    Json run;
+    run["entry"] = status.run_entry;
+    run["outcome"] = status.run_outcome;
+    run["samples"] = status.samples;
+    json["run"] = std::move(run);
+  }
   return line(json);
 }
 
-std::string format_show_response(const std::optional<store::CurrentCalibration>& current) {
+std::string format_show_response(const std::optional<store::CurrentCalibration>& current,
+                                 const std::optional<store::RunEntry>& run) {
   Json json;
   json["ok"] = true;
   json["present"] = current.has_value();
@@ -147,6 +157,18 @@ std::string format_show_response(const std::optional<store::CurrentCalibration>&
       rejected.push_back(std::move(reading));
     }
     json["rejected"] = std::move(rejected);
+    if (!run) {
+      json["run"] = nullptr;
+    } else {
+      Json entry;
+      entry["entry"] = run->path;
+      entry["outcome"] = run->log.outcome;
+      entry["samples"] = run->log.samples;
+      entry["skipped"] = run->log.skipped;
+      entry["robot_time_s"] = run->log.robot_time_s;
+      entry["diagnosis"] = run->log.diagnosis;
+      json["run"] = std::move(entry);
+    }
   }
   return line(json);
 }

@@ -7,20 +7,26 @@
 //   status   {"ok":true,"state":"settle","running":true,"waypoint":3,"waypoints":35,
 //             "samples":2,"skipped":0,"progress":0.12,"elapsed_s":41.2,
 //             "reason":"","note":"","detail":"platform moving: ...","device_faults":"",
-//             "committed_seq":0,"interrupted":"","store_problems":[],"pending_commit":false}
+//             "committed_seq":0,"interrupted":"","store_problems":[],"pending_commit":false,
+//             "run":{"entry":"/var/lib/cdpr-calib/history/run-000007","outcome":"running","samples":2}}
 //            elapsed_s: since the last run started (to its end when finished); null if never run
 //            device_faults: the devices' latched faults until reset-faults ("" when none)
 //            interrupted: "run interrupted at <time>, waypoint k of n ..." when a daemon died
 //            mid-run, until the next start; store_problems: unreadable stored files, one
-//            sentence each; pending_commit: a failed commit's fit waits for `commit`
+//            sentence each; pending_commit: a failed commit's fit waits for `commit`;
+//            run: the last run's history entry (docs/FORMATS.md "History entry of a run"; entry
+//            "" when none is kept), its outcome as in run.toml and its samples; null before a run
 //   show     {"ok":true,"present":true,"seq":4,"created":"2026-11-22T10:15:00Z","robot":"large",
 //             "model":["catenary"],"samples":35,
 //             "winches":[{"anchor":[x,y,z],"anchor_sigma":[..],"offset":3.2,"offset_sigma":0.03},...],
 //             "fit":{"cost_initial":..,"cost_final":..,"iterations":14,"rms_encoder":..,"rms_force":..},
-//             "model_warning":"","rejected":[{"row":12,"sensor":"encoder","cable":3,"residual":-95.4},...]}
+//             "model_warning":"","rejected":[{"row":12,"sensor":"encoder","cable":3,"residual":-95.4},...],
+//             "run":{"entry":"/var/lib/cdpr-calib/history/run-000007","outcome":"committed","samples":35,
+//                    "skipped":0,"robot_time_s":812.5,"diagnosis":""}}
 //            model_warning: why the model does not fit the data ("" when it fits); rejected: the
 //            readings left out of the fit as gross errors (calibration.toml [[rejected]]; residual
-//            in sigmas at the robust fit)
+//            in sigmas at the robust fit); run: the history entry of the run that produced this
+//            calibration (its samples, robot.toml and run.toml), null when none is kept
 //            {"ok":true,"present":false} when nothing was ever committed
 //   history  {"ok":true,"history":[{"seq":4,"current":true,"valid":true,"created":"..","robot":"..",
 //             "samples":35,"problem":""},...]}   newest first
@@ -36,13 +42,15 @@
 #include "hal/clock.h"
 #include "src/calibration/calibration_state.h"
 #include "src/store/calibration_store.h"
+#include "src/store/run_history.h"
 
 namespace cdpr::control {
 
 std::string format_error_response(std::string_view reason);
 std::string format_ok_response(std::string_view message);
 std::string format_status_response(const calibration::CalibrationStatus& status, hal::TimeUs now_us);
-std::string format_show_response(const std::optional<store::CurrentCalibration>& current);
+std::string format_show_response(const std::optional<store::CurrentCalibration>& current,
+                                 const std::optional<store::RunEntry>& run = std::nullopt);
 std::string format_history_response(const std::vector<store::HistoryEntry>& history);
 
 }  // namespace cdpr::control

@@ -58,6 +58,12 @@ struct ButtonConfig {
   hal::TimeUs debounce_us = 0;
 };
 
+// [history]: every run's data kept in the store's history (run_recorder.h).
+struct HistoryConfig {
+  double budget_mb = 0.0;    // disk budget of history/run-* [MB]
+  bool model_check = false;  // run the model check after each solve
+};
+
 using KeyLines = std::map<std::string, int, std::less<>>;
 
 // The daemon's defaults are the tables' (default_daemon_config()); a
@@ -65,6 +71,7 @@ using KeyLines = std::map<std::string, int, std::less<>>;
 struct DaemonConfig {
   std::string robot_path;  // robot.toml
   store::StoreOptions store;
+  HistoryConfig history;
   std::string control_socket;
   // Group given the control socket (mode 0660): its members may control the
   // daemon. A group name or a numeric id; empty: the daemon's own group.

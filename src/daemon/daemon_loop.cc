@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <optional>
 #include <vector>
 
 #include "src/control/control_dispatch.h"
@@ -31,6 +32,14 @@ DaemonLoop::DaemonLoop(const DaemonConfig& config, const Robot& robot, DaemonDev
       robot_,
       calibration::CalibratorDevices{devices_.winches, devices_.load_cell, devices_.pose, devices_.button, store_},
       config_.calibrator, calibration::SolveFunction{}, utc_now_rfc3339);
+  constexpr double kBytesPerMb = 1e6;
+  std::optional<DiagnosisOptions> model_check;
+  if (config_.history.model_check) {
+    model_check.emplace();
+    model_check->fit = config_.solver;
+  }
+  recorder_ = std::make_unique<RunRecorder>(
+      store_.state_dir(), static_cast<std::uintmax_t>(config_.history.budget_mb * kBytesPerMb), model_check);
 }
 
 DaemonLoop::~DaemonLoop() { shutdown(); }
@@ -53,10 +62,16 @@ hal::Status DaemonLoop::start() {
 void DaemonLoop::report_previous_state() {
   const auto marker = run_marker_.read();
   std::string interrupted;
+  std::string interrupted_at = utc_now_rfc3339();
   if (!marker) {
     interrupted = "a run was interrupted (its marker is unreadable: " + marker.error() + ")";
   } else if (*marker) {
     interrupted = describe_interrupted_run(**marker);
+    interrupted_at = (*marker)->updated;
+  }
+  for (const std::string& message : recorder_->recover(
+           interrupted_at, interrupted.empty() ? "the daemon stopped or died during the run" : interrupted)) {
+    if (log_) log_(message);
   }
   if (!interrupted.empty()) {
     run_marker_left_over_ = true;
@@ -111,6 +126,13 @@ void DaemonLoop::track_run() {
   run_marker_error_ = error;
 }
 
+void DaemonLoop::record_run() {
+  recorder_->track(*machine_, robot_);
+  for (const std::string& message : recorder_->take_messages()) {
+    if (log_) log_(message);
+  }
+}
+
 void DaemonLoop::log_device_faults() {
   const std::string& faults = machine_->status().device_faults;
   if (faults == logged_device_faults_) return;
@@ -151,6 +173,7 @@ void DaemonLoop::step(hal::TimeUs now_us) {
   machine_->step(now_us);
   manage_solve(now_us);
   track_run();
+  record_run();
   log_device_faults();
   report(now_us);
   notifier_.watchdog();
@@ -232,6 +255,11 @@ void DaemonLoop::shutdown() {
   if (calibration::is_running(machine_->status().state)) {
     machine_->request_abort(now_us, "daemon stopping");
     machine_->step(now_us);
+  }
+  record_run();
+  recorder_->finish();
+  for (const std::string& message : recorder_->take_messages()) {
+    if (log_) log_(message);
   }
   if (winches_open_) {
     // Stop every winch whatever the machine did: the daemon will not watch them any more.

@@ -15,6 +15,9 @@
 //   - keeps the run marker (run_marker.h) while a run is in progress, and
 //     at start reports a run a previous daemon left unfinished and what in
 //     the store is unreadable (log and status),
+//   - keeps every run's data in the history (run_recorder.h; written on a
+//     thread of its own, within [history] budget_mb; the model check after
+//     each solve runs there too),
 //   - reports READY, STATUS and WATCHDOG through the ServiceNotifier.
 // shutdown() stops the winches (abort a run: halt; then quick stop) and
 // closes the devices; the owner calls it on SIGTERM and exits 0.
@@ -39,6 +42,7 @@
 #include "src/daemon/control_server.h"
 #include "src/daemon/daemon_config.h"
 #include "src/daemon/run_marker.h"
+#include "src/daemon/run_recorder.h"
 #include "src/store/calibration_store.h"
 
 namespace cdpr::daemon {
@@ -85,6 +89,8 @@ class DaemonLoop {
   void shutdown();
 
   const calibration::CalibrationStateMachine& machine() const { return *machine_; }
+  // Waits until the run's data queued so far is on disk (tests).
+  void wait_for_history() { recorder_->wait_idle(); }
 
  private:
   void step(hal::TimeUs now_us);
@@ -100,6 +106,8 @@ class DaemonLoop {
   // Logs the devices' latched faults (EMCY, 0x603F, a refused
   // configuration) when they appear, change or are reset.
   void log_device_faults();
+  // The run recorder's queued writes for this step, and its failures logged.
+  void record_run();
 
   DaemonConfig config_;
   Robot robot_;
@@ -110,6 +118,7 @@ class DaemonLoop {
   std::function<void(const std::string&)> log_;
   std::unique_ptr<calibration::CalibrationStateMachine> machine_;
   std::unique_ptr<ControlServer> server_;
+  std::unique_ptr<RunRecorder> recorder_;
   std::future<CalibrationResult> solve_;
   bool solving_ = false;
 

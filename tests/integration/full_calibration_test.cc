@@ -2,13 +2,21 @@
 // the virtual robot (large preset, 35 waypoints) over real sockets, started
 // and followed through the control socket; the committed anchors must lie
 // within 0.10 m of the virtual robot's truth, and status is answered within
-// 100 ms all along.
+// 100 ms all along. The run's data is kept in its history entry, and
+// `cdpr-calib solve <entry>` reproduces the committed anchors from it.
 
 #include <chrono>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <thread>
 
+#include "daemon_process.h"
+#include "src/formats/calibration_toml.h"
+#include "src/formats/run_log_toml.h"
 #include "src/formats/samples_csv.h"
+#include "src/store/atomic_file.h"
+#include "src/store/run_history.h"
 #include "status_poller.h"
 #include "virtual_robot_rig.h"
 
@@ -32,6 +40,7 @@ TEST(FullCalibration, LargeRobotWith35WaypointsFindsTheAnchorsWithin10cm) {
     status = rig.ask("status");
   } while (status["running"].boolean() && std::chrono::steady_clock::now() < deadline);
   poller.stop();
+  rig.loop->wait_for_history();  // the run's data and the model check after its solve
   rig.stop_daemon();
   std::ofstream(rig.dir + "/samples.csv") << formats::format_samples_csv(rig.loop->machine().samples());
   rig.keep_dir = true;  // for diagnosis, unless everything below passes
@@ -58,6 +67,38 @@ TEST(FullCalibration, LargeRobotWith35WaypointsFindsTheAnchorsWithin10cm) {
               poller.over_ms(100.0), poller.worst_by_state().c_str());
   EXPECT_GT(poller.count(), 100u);
   EXPECT_LT(poller.quantile_ms(0.99), 100.0);
+
+  // AND the run's entry keeps its samples, the robot.toml it used, its log and the committed fit
+  const std::string entry = rig.config.store.state_dir + "/history/run-000001";
+  EXPECT_EQ(status["run"]["entry"].string(), entry);
+  EXPECT_EQ(status["run"]["outcome"].string(), "committed");
+  const auto log = formats::read_run_log_toml(entry + "/" + store::RunHistory::kLogName);
+  ASSERT_TRUE(log) << log.error().message();
+  EXPECT_EQ(log->outcome, "committed");
+  EXPECT_EQ(log->calibration, (*current)->seq);
+  EXPECT_EQ(log->samples, 35);
+  EXPECT_EQ(log->waypoints.size(), 35u);
+  EXPECT_GT(log->robot_time_s, 0.0);
+  std::printf("model check of the run: %s\n", log->diagnosis.c_str());
+  EXPECT_FALSE(log->diagnosis.empty());
+  const auto kept = formats::read_samples_csv(entry + "/" + store::RunHistory::kSamplesName, kCableCount);
+  ASSERT_TRUE(kept) << kept.error().message();
+  EXPECT_EQ(kept->size(), 35u);
+  const auto fit = store::read_file(entry + "/" + store::RunHistory::kCalibrationName);
+  ASSERT_TRUE(fit);
+  EXPECT_EQ(*fit, (*current)->text);
+  // AND `cdpr-calib solve <entry>` finds the committed anchors again from it
+  const std::string refit = rig.dir + "/refit.toml";
+  const std::string command = built_program("tools/cdpr-calib/cdpr-calib") + " solve " + entry + " -o " + refit +
+                              " -q --accept-misfit > " + rig.dir + "/refit.log 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  const auto refitted = formats::read_calibration_toml(refit);
+  ASSERT_TRUE(refitted) << refitted.error().message();
+  for (int i = 0; i < kCableCount; ++i) {
+    const double moved_m = (refitted->winches[i].anchor_world - calibration.winches[i].anchor_world).norm();
+    std::printf("cable %d: re-solved anchor from the history entry moved %.2e m\n", i, moved_m);
+    EXPECT_LT(moved_m, 1e-3) << "cable " << i;
+  }
   rig.keep_dir = ::testing::Test::HasFailure();
 }
 

@@ -42,6 +42,11 @@ std::string render_status(const JsonValue& s) {
   if (s["pending_commit"].boolean()) {
     out += "  pending: a fit whose commit failed is kept; `calibctl commit` commits it once the cause is fixed\n";
   }
+  if (const JsonValue run = s["run"]; !run.is_null()) {
+    const std::string entry = run["entry"].string();
+    out += format("  run: %s, %d samples, data in %s\n", run["outcome"].string().c_str(), run["samples"].integer(),
+                  entry.empty() ? "(not kept)" : entry.c_str());
+  }
   return out;
 }
 
@@ -84,6 +89,12 @@ std::string render_show(const JsonValue& s) {
       out += sensor == "force" ? std::string(8, ' ') : format(" cable %d", r["cable"].integer());
       out += format("  %+8.1f sigma\n", r["residual"].number());
     }
+  }
+  if (const JsonValue run = s["run"]; !run.is_null()) {
+    out += format("run: %s, %d samples, %d skipped, robot time %.1f s, data in %s\n", run["outcome"].string().c_str(),
+                  run["samples"].integer(), run["skipped"].integer(), run["robot_time_s"].number(),
+                  run["entry"].string().c_str());
+    if (!run["diagnosis"].string().empty()) out += "model check: " + run["diagnosis"].string() + "\n";
   }
   return out;
 }

@@ -29,10 +29,7 @@ void add_diagnose_command(CLI::App& app, DiagnoseArgs& args) {
       "Find where the model and the data disagree: by cross-validation, rank the known model terms by how much they "
       "improve the prediction of held-out poses, add the best while it is significant, and say when structure "
       "remains that no known term explains");
-  cmd->add_option("robot", args.robot_path, "robot.toml: nominal geometry, masses and sensor noise")
-      ->required()->check(CLI::ExistingFile);
-  cmd->add_option("samples", args.samples_path, "samples.csv: one row per static pose")
-      ->required()->check(CLI::ExistingFile);
+  add_input_options(*cmd, args.robot_path, args.samples_path);
   cmd->add_option("-o,--output", args.report_dir,
                   "report directory (created): report.txt, report.html, calibration.toml of the final model")
       ->capture_default_str();

@@ -12,10 +12,7 @@ namespace cdpr::tools {
 
 void add_solve_command(CLI::App& app, SolveArgs& args) {
   CLI::App* solve = app.add_subcommand("solve", "Calibrate anchors and encoder offsets from measured static poses");
-  solve->add_option("robot", args.robot_path, "robot.toml: nominal geometry, masses and sensor noise")
-      ->required()->check(CLI::ExistingFile);
-  solve->add_option("samples", args.samples_path, "samples.csv: one row per static pose")
-      ->required()->check(CLI::ExistingFile);
+  add_input_options(*solve, args.robot_path, args.samples_path);
   solve->add_option("-o,--output", args.output_path, "where to write calibration.toml")->capture_default_str();
   solve->add_option("--model", args.model,
                     "cable model: catenary (heavy sagging cable) or rigid (straight, massless), optionally followed "

@@ -25,7 +25,8 @@ TEST(ControlDispatch, StatusOfAnIdleDaemon) {
   EXPECT_EQ(ask(rig, "status"),
             "{\"ok\":true,\"state\":\"idle\",\"running\":false,\"waypoint\":0,\"waypoints\":0,\"samples\":0,"
             "\"skipped\":0,\"progress\":0,\"elapsed_s\":null,\"reason\":\"\",\"note\":\"\",\"detail\":\"\","
-            "\"device_faults\":\"\",\"committed_seq\":0,\"interrupted\":\"\",\"store_problems\":[],\"pending_commit\":false}\n");
+            "\"device_faults\":\"\",\"committed_seq\":0,\"interrupted\":\"\",\"store_problems\":[],\"pending_commit\":false,"
+            "\"run\":null}\n");
 }
 
 TEST(ControlDispatch, ResetFaultsReachesTheWinchBank) {
@@ -77,7 +78,7 @@ TEST(ControlDispatch, ShowHistoryAndRollbackAfterACalibration) {
 TEST(ControlDispatch, ShowListsTheRejectedReadingsAndTheModelWarning) {
   // GIVEN a clean committed calibration WHEN shown THEN no warning and no rejected reading
   CalibrationRig rig;
-  EXPECT_TRUE(ask(rig, "show").ends_with(",\"model_warning\":\"\",\"rejected\":[]}\n"));
+  EXPECT_TRUE(ask(rig, "show").ends_with(",\"model_warning\":\"\",\"rejected\":[],\"run\":null}\n"));
   // AND GIVEN a committed calibration.toml with two [[rejected]] readings and a model_warning
   Calibration calibration = store::test::calibration_version(2);
   calibration.rejected = {{12, SensorKind::kEncoder, 3, -95.4}, {24, SensorKind::kForce, 0, 8.25}};
@@ -88,7 +89,7 @@ TEST(ControlDispatch, ShowListsTheRejectedReadingsAndTheModelWarning) {
   EXPECT_TRUE(show.ends_with(
       "\"rms_force\":4.8},\"model_warning\":\"the model does not fit the data: chi-square 912.3 for 614 degrees "
       "of freedom\",\"rejected\":[{\"row\":12,\"sensor\":\"encoder\",\"cable\":3,\"residual\":-95.4},"
-      "{\"row\":24,\"sensor\":\"force\",\"cable\":0,\"residual\":8.25}]}\n"))
+      "{\"row\":24,\"sensor\":\"force\",\"cable\":0,\"residual\":8.25}],\"run\":null}\n"))
       << show;
 }
 

@@ -1,0 +1,22 @@
+#pragma once
+// The one-line verdict of the model check (solver/diagnosis/diagnosis.h) on
+// a run's data, for the run's log (run.toml `diagnosis`) and `calibctl show`:
+//
+//   "model explains the data (held-out normalized rms 1.02)"
+//   "elasticity explains the data: axial_stiffness = 1.52e+06 +- 3.1e+04"
+//   "load_cell_bias: force_bias = 12.1 +- 0.8; structure remains (held-out normalized rms 1.9, p = 2e-05)"
+//   "structure remains that no known effect explains (held-out normalized rms 2.4, p = 1e-09)"
+//   "model check could not run: <why>"
+//
+// Values in the [effects] names and units of docs/FORMATS.md. The verdict
+// only informs: the committed calibration keeps the daemon's model.
+
+#include <string>
+
+#include "solver/diagnosis/diagnosis.h"
+
+namespace cdpr::calibration {
+
+std::string model_check_verdict(const Diagnosis& diagnosis);
+
+}  // namespace cdpr::calibration

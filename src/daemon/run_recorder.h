@@ -1,0 +1,108 @@
+#pragma once
+// Keeps every calibration run's data in the store's history
+// (store/run_history.h): the entry is made when a run starts (robot.toml,
+// run.toml "running"), samples.csv and run.toml are rewritten at every
+// waypoint sampled or skipped, calibration.toml when a fit is validated,
+// and the final run.toml when the run ends, committed, failed or aborted.
+// Then the history is pruned to its disk budget, sparing the current
+// calibration's run and a fit waiting in pending/. When the run reached its
+// solve and a model check is configured, the check (solver/diagnosis) runs
+// on the run's samples and its verdict (model_check_verdict.h) is added to
+// run.toml; the calibration committed is not changed by it.
+//
+// The writes (each several fsyncs) run in order on a thread of their own,
+// so that a slow or full disk (or a long model check) never stalls the loop
+// that watches the winches: track() only copies the run's log and samples
+// into a queue. A next run's writes wait behind a model check in progress. A
+// failed write is never fatal and does not touch the calibration: it is
+// reported by take_messages() (path and errno), once per file and run.
+//
+// Thread-safety: track(), recover(), take_messages() and finish() from one
+// thread (the daemon's loop); the writer thread is internal.
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "solver/diagnosis/diagnosis_options.h"
+#include "solver/model/robot.h"
+#include "src/calibration/calibration_state_machine.h"
+#include "src/store/run_history.h"
+
+namespace cdpr::daemon {
+
+class RunRecorder {
+ public:
+  // `state_dir`: the store's (its history/ holds the entries, its
+  // calibration.toml and pending/ are what pruning spares).
+  // `model_check`: the options of the check after each solve; none: no check.
+  RunRecorder(std::string state_dir, std::uintmax_t budget_bytes,
+              std::optional<DiagnosisOptions> model_check = std::nullopt);
+  ~RunRecorder();  // finish()
+  RunRecorder(const RunRecorder&) = delete;
+  RunRecorder& operator=(const RunRecorder&) = delete;
+
+  // At start-up, before the first run: entries a daemon that died left
+  // "running" become "interrupted" (with `why`), then the history is pruned
+  // to its budget. Synchronous. Returns one message per event or failure.
+  std::vector<std::string> recover(const std::string& finished, const std::string& why);
+
+  // After every step of `machine`: queues the writes the run's progress
+  // calls for and names the entry in the machine's status.
+  void track(calibration::CalibrationStateMachine& machine, const Robot& robot);
+
+  // Failed writes and prunings since the last call, one sentence each.
+  std::vector<std::string> take_messages();
+
+  // Waits until every queued write is done (tests; shutdown).
+  void wait_idle();
+  // Writes what is queued (a model check not yet started is skipped), then
+  // stops the thread (idempotent).
+  void finish();
+
+  const store::RunHistory& history() const { return history_; }
+
+ private:
+  using Job = std::function<void()>;
+  void post(Job job);
+  void writer_loop();
+  // On the writer thread: notes a failure once per message and run.
+  void report(const std::string& message);
+  void prune();
+  // On the writer thread: the model check of a finished run, its verdict into run.toml.
+  void check_model(int run, formats::RunLog log, const Robot& robot, const std::vector<Sample>& samples);
+
+  store::RunHistory history_;
+  std::string state_dir_;
+  std::uintmax_t budget_bytes_;
+  std::optional<DiagnosisOptions> model_check_;
+
+  // Loop thread: what of the tracked run has been queued.
+  hal::TimeUs run_started_us_ = -1;
+  int run_ = 0;
+  int next_run_ = 0;
+  std::size_t waypoints_queued_ = 0;
+  std::size_t faults_queued_ = 0;
+  std::string outcome_queued_;
+  bool fit_queued_ = false;
+  bool solved_ = false;  // the run reached its solve
+
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::condition_variable idle_;
+  std::deque<Job> jobs_;
+  bool busy_ = false;
+  bool stopping_ = false;
+  std::vector<std::string> messages_;
+  std::set<std::string> reported_;  // this run's, writer thread only
+  std::thread writer_;
+};
+
+}  // namespace cdpr::daemon

@@ -1,0 +1,42 @@
+// The model check's one-line verdict: an effect named with value +- sigma,
+// "structure remains", or "model explains the data".
+
+#include "src/calibration/model_check_verdict.h"
+
+#include <gtest/gtest.h>
+
+namespace cdpr::calibration {
+namespace {
+
+Diagnosis finished(std::vector<Effect> model, bool structure_remains) {
+  Diagnosis d;
+  d.ok = true;
+  d.steps.emplace_back();
+  d.steps.back().model = std::move(model);
+  d.structure_remains = structure_remains;
+  d.structure_p_value = structure_remains ? 2e-5 : 0.4;
+  return d;
+}
+
+TEST(ModelCheckVerdict, NamesTheEffectWithItsValueAndSigma) {
+  // GIVEN a check that added elasticity and left nothing above the noise
+  Diagnosis d = finished({Effect::kElasticity}, false);
+  d.final_fit.calibration.effects["axial_stiffness"] = {1.52e6};
+  d.final_fit.calibration.effects["axial_stiffness_sigma"] = {3.1e4};
+  // WHEN put in words THEN the effect, its value and sigma come first
+  const std::string verdict = model_check_verdict(d);
+  EXPECT_EQ(verdict.rfind("elasticity: axial_stiffness = 1.52e+06 +- 3.1e+04 (explains the data", 0), 0u) << verdict;
+}
+
+TEST(ModelCheckVerdict, SaysWhenStructureRemainsOrTheModelExplainsTheData) {
+  EXPECT_EQ(model_check_verdict(finished({}, true)).rfind("structure remains that no known effect explains", 0), 0u)
+      << model_check_verdict(finished({}, true));
+  EXPECT_EQ(model_check_verdict(finished({}, false)).rfind("model explains the data", 0), 0u)
+      << model_check_verdict(finished({}, false));
+  Diagnosis failed;
+  failed.message = "too few samples";
+  EXPECT_EQ(model_check_verdict(failed), "model check could not run: too few samples");
+}
+
+}  // namespace
+}  // namespace cdpr::calibration
