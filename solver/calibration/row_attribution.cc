@@ -7,6 +7,7 @@
 #include <Eigen/Cholesky>
 
 #include "solver/nls/factor_parameters.h"
+#include "solver/nls/trust_region_strategy.h"
 
 namespace cdpr {
 namespace {
@@ -114,32 +115,43 @@ void apply_step(LocalProblem& local, const Eigen::VectorXd& step) {
   }
 }
 
-// Damped Gauss-Newton on the row's own variables without one reading;
-// returns the chi-square of the rest (infinity when it cannot be evaluated).
+// Levenberg-Marquardt on the row's own variables without the left-out
+// readings, its steps judged by the solver's TrustRegionStrategy; returns the
+// chi-square of the rest (infinity when it cannot be evaluated). The damping
+// starts small (the refit starts at the full fit's solution, near the
+// refit's own minimum), stays within [1e-12, 1e12] of J^T J's diagonal, and
+// the refit stops after 30 trial steps or once a step gains less than 1e-10
+// of the chi-square: what is compared across readings is the chi-square, and
+// the one left out is far above that.
+constexpr TrustRegionOptions kRefitTrustRegion{1e6, 1e12, 1e-12};
+
 double refit_without(const Problem& full, LocalProblem& local, const std::vector<int>& row_factors,
                      const LeftOut& left_out) {
   constexpr int kMaxIterations = 30;
+  constexpr double kStopGain = 1e-10;
   Linearised lin = linearise(full, local, row_factors, left_out);
   if (!lin.ok) return std::numeric_limits<double>::infinity();
   double chi2 = lin.residual.squaredNorm();
-  double damping = 1e-6;
-  for (int it = 0; it < kMaxIterations && damping < 1e12; ++it) {
-    Eigen::MatrixXd normal = lin.jacobian.transpose() * lin.jacobian;
-    normal.diagonal() += damping * normal.diagonal().cwiseMax(1e-9);
-    const Eigen::VectorXd step = normal.ldlt().solve(-lin.jacobian.transpose() * lin.residual);
+  TrustRegionStrategy strategy(kRefitTrustRegion);
+  for (int it = 0; it < kMaxIterations && !strategy.collapsed(); ++it) {
+    const Eigen::MatrixXd jtj = lin.jacobian.transpose() * lin.jacobian;
+    const Eigen::VectorXd gradient = lin.jacobian.transpose() * lin.residual;
+    Eigen::MatrixXd normal = jtj;
+    normal.diagonal() += strategy.damping() * jtj.diagonal().cwiseMax(1e-9);
+    const Eigen::VectorXd step = normal.ldlt().solve(-gradient);
+    // chi2 = |r|^2: the undamped model's decrease is -(2 g's + s'J'Js).
+    const double predicted = -(2.0 * gradient.dot(step) + step.dot(jtj * step));
     const std::vector<double> saved = local.problem.state();
     apply_step(local, step);
     const Linearised next = linearise(full, local, row_factors, left_out);
-    const double next_chi2 = next.ok ? next.residual.squaredNorm() : std::numeric_limits<double>::infinity();
-    if (next_chi2 < chi2) {
-      const bool converged = chi2 - next_chi2 < 1e-10 * chi2;
+    const double next_chi2 = next.ok ? next.residual.squaredNorm() : std::numeric_limits<double>::quiet_NaN();
+    if (strategy.judge_step(chi2, next_chi2, predicted)) {
+      const bool converged = chi2 - next_chi2 < kStopGain * chi2;
       lin = next;
       chi2 = next_chi2;
-      damping = std::max(damping / 10.0, 1e-12);
       if (converged) break;
     } else {
       local.problem.state() = saved;
-      damping *= 10.0;
     }
   }
   return chi2;

@@ -4,7 +4,7 @@
 // move (a Cauchy loss makes two moderate residuals cheaper than one large
 // one), so the largest residual may sit on the load cell or another cable.
 // Leave-one-out decides instead: the row's pose and force are refitted
-// (Gauss-Newton, everything global held) without each of its readings in
+// (Levenberg-Marquardt, everything global held) without each of its readings in
 // turn; the reading whose removal leaves the smallest chi-square of the
 // rest is the gross error, its residual that refit's prediction minus the
 // reading. While another reading still stands out in that refit, the one
