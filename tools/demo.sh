@@ -12,6 +12,8 @@
 # Usage: tools/demo.sh BUILD_DIR. Everything it starts is stopped on exit
 # (the daemon first, so it never sees its robot vanish). Exits non-zero when
 # the calibration is not committed or an anchor is 0.10 m or more off.
+# DEMO_SEED picks the virtual robot (default 7); DEMO_KEEP=DIR copies the
+# committed calibration.toml and the robot's truth.toml there.
 set -euo pipefail
 build=$(cd "${1:-build}" && pwd)
 work=$(mktemp -d /tmp/cdpr-demo.XXXXXX)
@@ -47,7 +49,7 @@ wait_for() {
 start=$(date +%s)
 echo "== virtual robot: large preset (240 x 220 x 50 m, 34 kg platform), physics 20x real time,"
 echo "   nominal anchors in robot.toml 0.3 m off the truth, encoder offsets unknown"
-"$build/tools/virtual-robot/virtual-robot" --preset large --seed 7 --time-scale 20 --anchor-perturbation 0.3 \
+"$build/tools/virtual-robot/virtual-robot" --preset large --seed "${DEMO_SEED:-7}" --time-scale 20 --anchor-perturbation 0.3 \
   --modbus-transport rtu --load-cell-model flintec-ft-11 \
   --endpoints "$work/robot" >"$work/virtual-robot.log" 2>&1 &
 pids+=($!)
@@ -75,12 +77,6 @@ endpoint = "unix:$work/robot/pose.sock"
 kind = "none"
 [limits]
 settle_timeout_s = 15.0
-[equilibrium]
-# The physics runs 20x faster, so a 1 s rest window suffices; the speed
-# limits allow for the preset's per-reading pose noise (5 mm, 0.01 rad).
-window_s = 1.0
-max_speed = 0.03
-max_angular_rate = 0.06
 EOF
 
 echo "== cdpr-calibd (foreground, state in $work/state)"
@@ -98,6 +94,10 @@ echo "== calibctl status --follow"
 echo "== calibctl show"
 "${calibctl[@]}" show
 
+if [[ -n ${DEMO_KEEP:-} ]]; then
+  mkdir -p "$DEMO_KEEP"
+  cp "$work/state/calibration.toml" "$work/robot/truth.toml" "$work/robot/robot.toml" "$DEMO_KEEP/"
+fi
 echo "== against the virtual robot's truth"
 awk '
   FNR == 1 { file++ }

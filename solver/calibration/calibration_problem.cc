@@ -178,8 +178,9 @@ BuiltProblem build_calibration_problem(const Robot& robot, const std::vector<Sam
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const int pose_index = static_cast<int>(k);
     problem.add_pose(PoseKey(pose_index), start_poses[k]);
-    problem.add_factor(std::make_unique<PosePriorFactor>(pose_index, measured_pose(samples[k]),
-                                                         robot.noise.position_m, robot.noise.orientation_rad, prior_loss));
+    const SampleSigmas sigma = reading_sigmas(robot, samples[k]);
+    problem.add_factor(std::make_unique<PosePriorFactor>(pose_index, measured_pose(samples[k]), sigma.position_m,
+                                                         sigma.orientation_rad, prior_loss));
     built.reading_factor.push_back(static_cast<int>(problem.factors().size()));
     if (catenary) {
       problem.add_vector(ReferenceForceKey(pose_index), forces[k]);
@@ -193,7 +194,7 @@ BuiltProblem build_calibration_problem(const Robot& robot, const std::vector<Sam
     } else {
       for (int i = 0; i < kCableCount; ++i) {
         problem.add_factor(std::make_unique<RigidEncoderFactor>(
-            pose_index, i, robot.winches[i].attachment_platform, samples[k].encoder_m[i], robot.noise.encoder_m, loss));
+            pose_index, i, robot.winches[i].attachment_platform, samples[k].encoder_m[i], sigma.encoder_m[i], loss));
       }
     }
   }

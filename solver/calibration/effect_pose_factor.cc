@@ -39,6 +39,7 @@ EffectPoseFactor::EffectPoseFactor(const Robot& robot, int pose_index, const Sam
     : robot_(robot),
       encoder_m_(sample.encoder_m),
       force_n_(sample.force_n),
+      sigma_(reading_sigmas(robot, sample)),
       left_out_(left_out_rows(sample)),
       sigma_height_m_(sigma_height_m),
       loss_(loss) {
@@ -116,8 +117,8 @@ bool EffectPoseFactor::evaluate_model(const double* const* parameters, double* r
   double* const radius_block = effect_jacobian(jacobians, Effect::kPulleyRadius);
 
   const double nominal_weight = robot_.gravity_mps2 * robot_.cable_linear_density_kgpm;
-  const double sigma_encoder = robot_.noise.encoder_m;
   for (int i = 0; i < kCableCount; ++i) {
+    const double sigma_encoder = sigma_.encoder_m[i];
     const CableStatics& c = cables[i];
     // A cable pushing (f_h <= 0) has no catenary: the point is outside the model.
     if (!(c.f_h > 0.0)) return false;
@@ -158,7 +159,7 @@ bool EffectPoseFactor::evaluate_model(const double* const* parameters, double* r
   const int force_row = 2 * kCableCount;
   const double tension = in.reference_force.norm();
   const double force_gain = 1.0 + (load_cell ? load_cell[1] : 0.0);
-  const double sigma_force = robot_.noise.force_n;
+  const double sigma_force = sigma_.force_n;
   // The two biases add, so the Jacobians stay exact even for a model that has
   // both (calibrate() refuses one; the factor need not).
   const double bias = (load_cell ? load_cell[0] : 0.0) + (bias_only ? bias_only[0] : 0.0);

@@ -66,6 +66,7 @@ class EffectPoseFactor final : public Factor {
   std::array<int, kEffectCount> effect_slot_;  // index into keys_, -1 when absent
   std::array<double, kCableCount> encoder_m_;
   double force_n_;
+  SampleSigmas sigma_;  // the row's reading sigmas (reading_sigmas())
   LeftOutRows left_out_;  // readings left out as gross errors (Sample::encoder_left_out, force_left_out)
   double sigma_height_m_;
   Loss loss_;

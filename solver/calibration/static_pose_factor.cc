@@ -81,6 +81,7 @@ StaticPoseFactor::StaticPoseFactor(const Robot& robot, int pose_index, const Sam
     : robot_(robot),
       encoder_m_(sample.encoder_m),
       force_n_(sample.force_n),
+      sigma_(reading_sigmas(robot, sample)),
       left_out_(left_out_rows(sample)),
       sigma_height_m_(sigma_height_m),
       loss_(loss) {
@@ -105,8 +106,8 @@ bool StaticPoseFactor::evaluate(const double* const* parameters, double* residua
   if (solve_platform_statics(robot_, in, with_jacobian, cables) != StaticsStatus::kOk) return false;
 
   const double weight_per_length = robot_.gravity_mps2 * robot_.cable_linear_density_kgpm;
-  const double sigma_encoder = robot_.noise.encoder_m;
   for (int i = 0; i < kCableCount; ++i) {
+    const double sigma_encoder = sigma_.encoder_m[i];
     const CableStatics& c = cables[i];
     // A cable pushing (f_h <= 0) has no catenary: the point is outside the model.
     if (!(c.f_h > 0.0)) return false;
@@ -129,7 +130,7 @@ bool StaticPoseFactor::evaluate(const double* const* parameters, double* residua
   // Eq. (16): the load cell measures the tension magnitude of the reference cable.
   const int force_row = 2 * kCableCount;
   const double tension = in.reference_force.norm();
-  const double sigma_force = robot_.noise.force_n;
+  const double sigma_force = sigma_.force_n;
   residual[force_row] = (tension - force_n_) / sigma_force;
   if (with_jacobian) {
     const Eigen::Vector2d d_force =

@@ -131,8 +131,9 @@ HeldOutEvaluation evaluate_held_out(const Robot& robot, const std::vector<Sample
     const EffectPoseFactor factor(robot, pose_index, built.samples[k], options.height_sigma_m, Loss{}, options.effects);
     const std::vector<const double*> blocks = parameter_blocks(problem, factor);
     HeldOutPose pose{built.samples[k], problem.pose(PoseKey(pose_index)), {}, 0.0};
+    const SampleSigmas sigma = reading_sigmas(robot, built.samples[k]);
     const PosePriorFactor prior(pose_index, {built.samples[k].position_world, built.samples[k].world_R_platform},
-                                robot.noise.position_m, robot.noise.orientation_rad, Loss{});
+                                sigma.position_m, sigma.orientation_rad, Loss{});
     std::array<double, EffectPoseFactor::kResidualDim> residual;
     std::array<double, 6> prior_residual;
     double cost = 0.0, prior_cost = 0.0;

@@ -67,7 +67,7 @@ bool height_and_force(const Robot& robot, const ReferenceForceMap& map, const Sa
     }
   }
   const double tension = force.norm();
-  const double sigma_force = robot.noise.force_n;
+  const double sigma_force = reading_sigmas(robot, sample).force_n;
   residual(kCableCount) = (tension - sample.force_n) / sigma_force;
   if (jacobian) {
     jacobian->row(kCableCount).setZero();
@@ -193,7 +193,7 @@ std::optional<ForceAndHeading> refine_reference_force_and_heading(
     const Eigen::Vector2d& guess, double yaw_guess_rad, double yaw_min_rad, double yaw_max_rad, double sigma_height_m) {
   using Jacobian3 = Eigen::Matrix<double, kFitRows, 3>;
   const double weight_per_length = robot.gravity_mps2 * robot.cable_linear_density_kgpm;
-  const double sigma_force = robot.noise.force_n;
+  const double sigma_force = reading_sigmas(robot, sample).force_n;
   // Residuals and their Jacobian in (f_h, f_v, yaw) at one point: the
   // statics factorised at that heading, each catenary evaluated once.
   auto evaluate = [&](const Eigen::Vector2d& force, double yaw, FitResiduals& residual, Jacobian3& jacobian) {

@@ -10,6 +10,17 @@
 
 namespace cdpr {
 
+// The 1-sigma noise of one row's readings, when the row knows it better than
+// robot.toml's per-reading [noise]: a row that averages a rest window is far
+// less noisy than a single reading (samples.csv's optional sigma columns).
+// Every value > 0 when given.
+struct SampleSigmas {
+  std::array<double, kCableCount> encoder_m{};  // [m] per cable
+  double force_n = 0.0;                         // [N]
+  double position_m = 0.0;                      // [m] each axis of the pose translation
+  double orientation_rad = 0.0;                 // [rad] each axis of the pose rotation
+};
+
 struct Sample {
   int id = 0;
   Eigen::Vector3d position_world = Eigen::Vector3d::Zero();                // [m] platform origin
@@ -20,6 +31,23 @@ struct Sample {
   // the model fits the rest of the row without them. Not in samples.csv.
   std::array<bool, kCableCount> encoder_left_out{};
   bool force_left_out = false;
+  // The row's own noise; all zero when it has none and robot.toml's
+  // per-reading sigmas weight it. (A plain value, not std::optional: GCC
+  // warns falsely about moving a disengaged optional of doubles.)
+  SampleSigmas sigma;
+  bool has_own_sigma() const { return sigma.force_n > 0.0; }
 };
+
+// The sigmas that weight `sample` in a fit: its own when it has them, else
+// the robot's per-reading ones.
+inline SampleSigmas reading_sigmas(const Robot& robot, const Sample& sample) {
+  if (sample.has_own_sigma()) return sample.sigma;
+  SampleSigmas s;
+  s.encoder_m.fill(robot.noise.encoder_m);
+  s.force_n = robot.noise.force_n;
+  s.position_m = robot.noise.position_m;
+  s.orientation_rad = robot.noise.orientation_rad;
+  return s;
+}
 
 }  // namespace cdpr

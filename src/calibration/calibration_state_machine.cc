@@ -283,7 +283,8 @@ void CalibrationStateMachine::run_settle(hal::TimeUs now_us) {
   const Readings& readings = monitor_.readings();
   if (readings.pose_is_new && readings.tension) {
     EquilibriumObservation o;
-    o.time_us = readings.pose->received_us;
+    // The source's stamp: rates are the platform's (equilibrium_detector.h).
+    o.time_us = readings.pose->source_time_us;
     o.position_world = Eigen::Vector3d(readings.pose->platform_world.x, readings.pose->platform_world.y,
                                        readings.pose->platform_world.z);
     const hal::Quaternion& q = readings.pose->world_R_platform;
@@ -316,6 +317,7 @@ void CalibrationStateMachine::run_settle(hal::TimeUs now_us) {
 
 void CalibrationStateMachine::run_sample(hal::TimeUs now_us) {
   Sample sample = detector_.average();
+  sample.sigma = detector_.average_sigmas(robot_.noise);
   sample.id = static_cast<int>(samples_.size());
   samples_.push_back(sample);
   status_.samples = static_cast<int>(samples_.size());

@@ -107,5 +107,38 @@ TEST(EffectPoseFactor, PredictionReportsPhysicalResiduals) {
   EXPECT_NEAR(with_bias.force_residual_n - without.force_residual_n, 15.0, 1e-9);
 }
 
+// GIVEN a row carrying its own sigmas, THEN its reading rows are whitened by
+// them instead of robot.toml's, in both pose factors.
+TEST(PoseFactors, ARowsOwnSigmasSetItsWeight) {
+  const Robot robot = test::large_robot();
+  const PoseSetup s = setup_for(robot, {100, 80, 12});
+  Sample own = s.sample;
+  own.sigma = SampleSigmas{{robot.noise.encoder_m / 10.0, robot.noise.encoder_m / 2.0, robot.noise.encoder_m,
+                            robot.noise.encoder_m * 4.0},
+                           robot.noise.force_n / 5.0, robot.noise.position_m, robot.noise.orientation_rad};
+  const auto vars = variables(robot, s, {});
+  std::vector<const double*> params;
+  for (const auto& v : vars) params.push_back(v.ambient.data());
+  const auto residuals = [&](const Factor& factor) {
+    std::array<double, EffectPoseFactor::kResidualDim> r;
+    double cost = 0.0;
+    EXPECT_TRUE(factor.evaluate(params.data(), r.data(), nullptr, &cost));
+    return r;
+  };
+  const auto check = [&](const Factor& robot_weighted, const Factor& row_weighted) {
+    const auto r_robot = residuals(robot_weighted);
+    const auto r_row = residuals(row_weighted);
+    for (int i = 0; i < kCableCount; ++i) {
+      EXPECT_NEAR(r_row[i], r_robot[i] * robot.noise.encoder_m / own.sigma.encoder_m[i], 1e-9 * std::abs(r_row[i]))
+          << "encoder " << i;
+      EXPECT_EQ(r_row[kCableCount + i], r_robot[kCableCount + i]) << "height " << i;  // not a reading
+    }
+    const int force = 2 * kCableCount;
+    EXPECT_NEAR(r_row[force], r_robot[force] * 5.0, 1e-9 * std::abs(r_row[force]));
+  };
+  check(StaticPoseFactor(robot, 0, s.sample, 1e-3, Loss{}), StaticPoseFactor(robot, 0, own, 1e-3, Loss{}));
+  check(EffectPoseFactor(robot, 0, s.sample, 1e-3, Loss{}, {}), EffectPoseFactor(robot, 0, own, 1e-3, Loss{}, {}));
+}
+
 }  // namespace
 }  // namespace cdpr

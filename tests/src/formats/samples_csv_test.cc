@@ -173,5 +173,74 @@ TEST(SamplesCsv, FormatThenParseGivesTheSameSamples) {
   }
 }
 
+const std::string kWithSigmas =
+    "sample,x,y,z,qw,qx,qy,qz,enc0,enc1,enc2,enc3,force,sigma_enc0,sigma_enc1,sigma_enc2,sigma_enc3,sigma_force,"
+    "sigma_pos,sigma_rot\n"
+    "0,112.31,104.92,12.07,1,0,0,0,171.233,182.904,166.118,190.451,702.4,0.001,0.002,0.003,0.004,0.5,0.0006,0.0007\n"
+    "1,80.5,90.25,10.5,1,0,0,0,150.5,160.25,170.125,180.0625,650,,,,,,,\n";
+
+TEST(SamplesCsv, SigmaColumnsAreReadPerRow) {
+  // GIVEN a file with the optional sigma columns, the second row leaving them empty
+  // WHEN it is parsed
+  const auto samples = parse_samples_csv(kWithSigmas, "samples.csv", kCableCount);
+  // THEN the first row has its own sigmas, the second none
+  ASSERT_TRUE(samples.has_value()) << samples.error().message();
+  ASSERT_TRUE((*samples)[0].has_own_sigma());
+  EXPECT_EQ((*samples)[0].sigma.encoder_m, (std::array<double, kCableCount>{0.001, 0.002, 0.003, 0.004}));
+  EXPECT_EQ((*samples)[0].sigma.force_n, 0.5);
+  EXPECT_EQ((*samples)[0].sigma.position_m, 0.0006);
+  EXPECT_EQ((*samples)[0].sigma.orientation_rad, 0.0007);
+  EXPECT_FALSE((*samples)[1].has_own_sigma());
+}
+
+TEST(SamplesCsv, FileWithoutSigmaColumnsHasNoRowSigmas) {
+  const auto samples = parse_samples_csv(kExample, "samples.csv", kCableCount);
+  ASSERT_TRUE(samples.has_value());
+  for (const Sample& s : *samples) EXPECT_FALSE(s.has_own_sigma());
+}
+
+TEST(SamplesCsv, SigmaColumnsComeAllTogetherAndPositive) {
+  // GIVEN one sigma column missing THEN the header is refused naming it
+  const FormatError missing = parse_error(test::replaced(kWithSigmas, ",sigma_rot", ""));
+  EXPECT_EQ(missing.field, "sigma_rot");
+  EXPECT_NE(missing.reason.find("all together"), std::string::npos) << missing.reason;
+  // GIVEN a row with some sigmas empty THEN the row is refused
+  const FormatError partial = parse_error(test::replaced(kWithSigmas, ",0.0007\n", ",\n"));
+  EXPECT_EQ(partial.field, "sigma_rot");
+  EXPECT_EQ(partial.line, 2);
+  // GIVEN a zero sigma THEN refused
+  const FormatError zero = parse_error(test::replaced(kWithSigmas, ",0.5,", ",0,"));
+  EXPECT_EQ(zero.field, "sigma_force");
+  EXPECT_NE(zero.reason.find("> 0"), std::string::npos) << zero.reason;
+}
+
+TEST(SamplesCsv, FormatThenParseKeepsRowSigmas) {
+  // GIVEN two samples, one with its own sigmas and one without
+  std::vector<Sample> samples(2);
+  samples[0].id = 0;
+  samples[1].id = 1;
+  samples[0].sigma = SampleSigmas{{1.0 / 3.0, 2e-4, 3e-4, 4e-4}, 0.25, 1.0 / 7.0, 2e-5};
+  // WHEN formatted and parsed again
+  const std::string text = format_samples_csv(samples);
+  const auto again = parse_samples_csv(text, "written.csv", kCableCount);
+  // THEN the sigmas come back bit-identical, and the row without stays without
+  ASSERT_TRUE(again.has_value()) << again.error().message() << "\n" << text;
+  ASSERT_TRUE((*again)[0].has_own_sigma());
+  EXPECT_EQ((*again)[0].sigma.encoder_m, samples[0].sigma.encoder_m);
+  EXPECT_EQ((*again)[0].sigma.force_n, samples[0].sigma.force_n);
+  EXPECT_EQ((*again)[0].sigma.position_m, samples[0].sigma.position_m);
+  EXPECT_EQ((*again)[0].sigma.orientation_rad, samples[0].sigma.orientation_rad);
+  EXPECT_FALSE((*again)[1].has_own_sigma());
+}
+
+TEST(SamplesCsv, SamplesWithoutSigmasAreWrittenAsBefore) {
+  // GIVEN samples without their own sigmas WHEN formatted
+  std::vector<Sample> samples(1);
+  const std::string text = format_samples_csv(samples);
+  // THEN the header has no sigma column
+  EXPECT_EQ(text.find("sigma"), std::string::npos) << text;
+  EXPECT_NE(text.find("\nsample,x,y,z,qw,qx,qy,qz,enc0,enc1,enc2,enc3,force\n"), std::string::npos) << text;
+}
+
 }  // namespace
 }  // namespace cdpr::formats
