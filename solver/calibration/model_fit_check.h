@@ -1,0 +1,14 @@
+#pragma once
+// The test that a final fit's model explains its data, applied by calibrate().
+
+#include "solver/calibration/calibrate.h"
+
+namespace cdpr {
+
+// The model-fit test of a final fit: chi-square against its degrees of
+// freedom, and a problem with fewer redundant rows than global unknowns
+// (3 poses of 4 cables, say) is under-determined whatever its chi-square.
+// A misfit scales the sigmas up by sqrt(chi2 / dof), never down.
+void assess_model_fit(CalibrationResult& result, const CalibrationOptions& options);
+
+}  // namespace cdpr
