@@ -55,7 +55,7 @@ Table<HistoryConfig> history_table() {
   Table<HistoryConfig> t("history");
   t.number("budget_mb", &HistoryConfig::budget_mb, 200.0, kNonNegative, "MB",
            "every run's data is kept in history/run-*; beyond this the oldest go, never the current "
-           "calibration's run nor a pending fit's");
+           "calibration's run, a pending fit's nor the last run");
   t.boolean("model_check", &HistoryConfig::model_check, true,
             "after each solve, check the model on the run's data (cdpr-calib diagnose) and record the verdict");
   return t;

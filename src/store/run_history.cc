@@ -147,8 +147,10 @@ StoreResult<std::vector<int>> RunHistory::prune(std::uintmax_t budget_bytes,
   std::uintmax_t total = 0;
   for (const RunEntry& entry : *list) total += entry.bytes;
   std::vector<int> removed;
-  // Oldest first: the list is newest first.
-  for (auto entry = list->rbegin(); entry != list->rend() && total > budget_bytes; ++entry) {
+  // Oldest first: the list is newest first. The newest entry is the last
+  // run, which status and show name; it stays whatever the budget.
+  const auto newest = list->empty() ? list->rend() : std::prev(list->rend());
+  for (auto entry = list->rbegin(); entry != newest && total > budget_bytes; ++entry) {
     if (entry->valid && entry->log.outcome == formats::kRunRunning) continue;
     const auto calibration = read_file(entry->path + "/" + kCalibrationName);
     if (calibration && std::find(protected_calibrations.begin(), protected_calibrations.end(), *calibration) !=

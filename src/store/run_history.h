@@ -16,7 +16,8 @@
 // Disk budget: prune() removes whole entries, oldest first, until the
 // entries fit the budget, but never an entry whose calibration.toml is one
 // of the protected texts (the current calibration, a fit waiting in
-// pending/) nor one still running. An entry without a readable run.toml (a
+// pending/), nor one still running, nor the newest (the last run, which
+// the daemon's status names). An entry without a readable run.toml (a
 // crash between its mkdir and its first file) is pruned like any other.
 //
 // Not thread-safe; the daemon uses one object on one thread at a time (its

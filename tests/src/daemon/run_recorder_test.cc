@@ -145,19 +145,26 @@ TEST(RunRecorder, ARunTheDaemonDidNotFinishIsFoundInterruptedAtTheNextStart) {
   EXPECT_EQ(*next.history().next_run(), 2);
 }
 
-TEST(RunRecorder, TheBudgetPrunesOlderRunsButNeverTheCurrentCalibrations) {
-  // GIVEN a budget of nothing, a committed run and an aborted one after it
+TEST(RunRecorder, TheBudgetPrunesOlderRunsButNeverTheCurrentCalibrationsNorTheLast) {
+  // GIVEN a budget of nothing, a committed run and two aborted ones after it
   RecordedRig r(0);
   ASSERT_TRUE(r.run_to_end());
   ASSERT_EQ(r.rig.status().state, CalibrationState::kDone);
-  r.rig.button.press();
-  ASSERT_TRUE(r.run_until([&] { return r.rig.status().samples == 1; }));
-  r.rig.machine->request_abort(r.rig.clock.now_us());
-  ASSERT_TRUE(r.run_until([] { return true; }));
-  r.settle();
-  // THEN the aborted run is pruned, the current calibration's run stays, and the log says so
+  const auto run_and_abort = [&r] {
+    r.rig.button.press();
+    ASSERT_TRUE(r.run_until([&] { return r.rig.status().samples == 1; }));
+    r.rig.machine->request_abort(r.rig.clock.now_us());
+    ASSERT_TRUE(r.run_until([] { return true; }));
+    r.settle();
+  };
+  run_and_abort();
+  // THEN the last run stays while it is the newest
+  EXPECT_TRUE(std::filesystem::exists(r.entry(2) + "/run.toml"));
+  run_and_abort();
+  // THEN the older aborted run is pruned, the current calibration's run and the last stay, and the log says so
   EXPECT_TRUE(std::filesystem::exists(r.entry(1) + "/samples.csv"));
   EXPECT_FALSE(std::filesystem::exists(r.entry(2)));
+  EXPECT_TRUE(std::filesystem::exists(r.entry(3) + "/run.toml"));
   EXPECT_TRUE(contains(joined(r.messages), "removed run-000002")) << joined(r.messages);
 }
 

@@ -120,10 +120,23 @@ TEST(RunHistory, AnEntryACrashLeftWithoutLogIsListedWithItsProblemAndPrunable) {
   ASSERT_TRUE(entries);
   EXPECT_FALSE(entries->back().valid);
   EXPECT_TRUE(contains(entries->back().problem, "run-000001/run.toml")) << entries->back().problem;
-  // WHEN pruned to a budget of nothing THEN it goes like any other
+  // WHEN pruned to a budget of nothing THEN it goes like any other older entry
   const auto removed = r.history.prune(0, {});
   ASSERT_TRUE(removed);
-  EXPECT_EQ(*removed, (std::vector<int>{1, 2}));
+  EXPECT_EQ(*removed, (std::vector<int>{1}));
+}
+
+TEST(RunHistory, TheNewestRunStaysWhateverTheBudget) {
+  // GIVEN two finished runs, the newest failed (the one status names)
+  Runs r;
+  r.add(1, formats::kRunFailed, 1000);
+  r.add(2, formats::kRunFailed, 1000);
+  // WHEN pruned to a budget of nothing
+  const auto removed = r.history.prune(0, {});
+  // THEN the older goes and the newest stays
+  ASSERT_TRUE(removed) << removed.error().message();
+  EXPECT_EQ(*removed, (std::vector<int>{1}));
+  EXPECT_EQ(r.listed(), (std::vector<int>{2}));
 }
 
 TEST(RunHistory, RunsLeftRunningBecomeInterruptedAndTheirTempFilesGo) {
