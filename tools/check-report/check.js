@@ -100,7 +100,7 @@
       if (role === 'presentation' || role === 'none' || svg.getAttribute('aria-hidden') === 'true') continue;
       plots.push(svg);
     }
-    var totalMarks = 0;
+    var totalMarks = 0, untagged = 0;
     plots.forEach(function (svg, index) {
       var frame = svg.getBoundingClientRect();
       var title = svg.querySelector('title, text');
@@ -110,6 +110,7 @@
         return;
       }
       var tagged = svg.querySelector('.data') !== null;
+      if (!tagged) ++untagged;
       var shapes = svg.querySelectorAll(tagged ? '.data, .data *' : 'circle, ellipse, path, polygon, polyline');
       var marks = 0;
       for (var j = 0; j < shapes.length; ++j) {
@@ -130,7 +131,7 @@
         }
       }
     });
-    return { plots: plots.length, marks: totalMarks };
+    return { plots: plots.length, marks: totalMarks, untagged: untagged };
   }
 
   // Self-contained: nothing loaded but the page itself, data: URLs and
@@ -152,8 +153,12 @@
     var verdict = document.createElement('pre');
     verdict.id = 'cdpr-report-check';
     verdict.hidden = true;
-    verdict.textContent = ['info viewport ' + width + ' px', 'info plots ' + found.plots + ', data marks ' + found.marks]
-                              .concat(problems).join('\n');
+    var lines = ['info viewport ' + width + ' px', 'info plots ' + found.plots + ', data marks ' + found.marks];
+    if (found.untagged > 0) {
+      lines.push('info ' + found.untagged + ' plots mark no element of class "data": every circle, ellipse, path, ' +
+                 'polygon and polyline counted as data (legend swatches too)');
+    }
+    verdict.textContent = lines.concat(problems).join('\n');
     (document.body || document.documentElement).appendChild(verdict);
   }
 
