@@ -27,11 +27,11 @@ simulate() {
 case $kind in
   diagnose-effect)  # an effect named and fitted: before and after plots
     simulate --seed 11 --axial-stiffness 1.5e6
-    "$calib" diagnose "$out/data/robot.toml" "$out/data/samples.csv" -o "$out/report" >"$out/diagnose.txt"
+    "$calib" diagnose "$out/data/robot.toml" "$out/data/samples.csv" -o "$out/report" >"$out/diagnose.txt" 2>&1
     report=$out/report/report.html ;;
   diagnose-structure)  # no effect explains the data: structure remains
     simulate --seed 11 --wind 100,60,0
-    "$calib" diagnose "$out/data/robot.toml" "$out/data/samples.csv" -o "$out/report" >"$out/diagnose.txt"
+    "$calib" diagnose "$out/data/robot.toml" "$out/data/samples.csv" -o "$out/report" >"$out/diagnose.txt" 2>&1
     report=$out/report/report.html ;;
   *)
     echo "unknown report kind $kind" >&2
