@@ -12,11 +12,12 @@ comma      := ,
 DEB_PACKAGES := build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev \
                 libmodbus-dev libsystemd-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev \
                 libgtest-dev libgmock-dev libbenchmark-dev libgpiod-dev systemd \
-                mbpoll libseccomp-dev bubblewrap lintian
+                mbpoll libseccomp-dev bubblewrap lintian chromium tidy
 # mbpoll: a Modbus master neither the daemon nor the virtual robot shares
 # code with, for the load cell's cross-check test. libseccomp-dev and
 # bubblewrap: the test that runs the daemon in the unit's sandbox. lintian:
-# the package test.
+# the package test. chromium and tidy: the tests that read the HTML reports
+# in a headless browser and check them as HTML5 (tools/check-report).
 # Ceres is used by the benchmark comparison only, never linked into the daemon.
 BENCH_PACKAGES := libceres-dev
 # clang and its runtimes (libFuzzer, ASan, UBSan) for make fuzz only.
