@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 #include "virtual_robot_process.h"
 
@@ -29,9 +30,17 @@ std::vector<std::string> in_own_mount_namespace(const std::string& dir, bool rea
   return {"unshare", "-m", "--propagation", "private", "sh", "-c", script + " && exec \"$0\" \"$@\""};
 }
 
+// A read-only remount is refused (EBUSY) while the daemon's run recorder has
+// a file of the history open for writing; each write is short, so a few
+// tries a moment apart find it closed.
 bool remount(pid_t pid, const std::string& dir, const char* mode) {
   const std::string command =
       "nsenter -t " + std::to_string(pid) + " -m mount -o remount,bind," + mode + " '" + dir + "'";
+  constexpr int kTries = 50;
+  for (int attempt = 1; attempt < kTries; ++attempt) {
+    if (std::system((command + " 2>/dev/null").c_str()) == 0) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
   return std::system(command.c_str()) == 0;
 }
 
