@@ -260,13 +260,18 @@ report::Verdict verdict_of(const Diagnosis& d, const ReportContext& c) {
   const CalibrationResult& fit = d.final_fit.ok ? d.final_fit : last.fit;
   const std::string values = report::effect_values_text(fit.calibration.effects, value_names(added));
   v.facts.emplace_back("added", added.empty() ? "nothing" : values.empty() ? effect_list(added) : values);
+  // "a -> b" when the workflow changed the model, else the one value.
+  const auto change = [&](const char* fmt, double before, double after) {
+    return d.steps.size() > 1 ? format_text(fmt, before) + " -> " + format_text(fmt, after) : format_text(fmt, after);
+  };
   v.facts.emplace_back(
       "held-out misfit",
-      format_text("normalised rms %.2f -> %.2f (1 = noise floor; structure p = %.2g); encoder rms %.1f -> %.1f mm "
-                  "(noise %.1f mm), load cell %.2f -> %.2f N (noise %.2f N)",
-                  first.held_out.normalized_rms(), last.held_out.normalized_rms(), d.structure_p_value,
-                  1000.0 * first.held_out.rms_encoder_m, 1000.0 * last.held_out.rms_encoder_m, 1000.0 * c.noise.encoder_m,
-                  first.held_out.rms_force_n, last.held_out.rms_force_n, c.noise.force_n));
+      "normalised rms " + change("%.2f", first.held_out.normalized_rms(), last.held_out.normalized_rms()) +
+          format_text(" (1 = noise floor; structure p = %.2g); encoder rms ", d.structure_p_value) +
+          change("%.1f", 1000.0 * first.held_out.rms_encoder_m, 1000.0 * last.held_out.rms_encoder_m) +
+          format_text(" mm (noise %.1f mm), load cell ", 1000.0 * c.noise.encoder_m) +
+          change("%.2f", first.held_out.rms_force_n, last.held_out.rms_force_n) +
+          format_text(" N (noise %.2f N)", c.noise.force_n));
   std::string anchors = c.nominal ? report::anchors_moved_text(*c.nominal, fit.calibration) : "";
   if (!added.empty() && first.fit.ok) {
     anchors = "the added terms moved them by " + report::anchors_shift_text(first.fit.calibration, fit.calibration) +
@@ -280,9 +285,11 @@ report::Verdict verdict_of(const Diagnosis& d, const ReportContext& c) {
       worst = std::max(worst, sigma_distance(fit.calibration.effects, c.truth->effects, name));
     }
     v.facts.emplace_back("against truth",
-                         format_text("mean anchor error %.2f -> %.2f mm%s", 1000.0 * mean_anchor_error(first.fit.calibration, *c.truth),
-                                     1000.0 * mean_anchor_error(fit.calibration, *c.truth),
-                                     added.empty() ? "" : format_text("; added terms %.1f sigma from the true values", worst).c_str()));
+                         "mean anchor error " +
+                             change("%.1f", 1000.0 * mean_anchor_error(first.fit.calibration, *c.truth),
+                                    1000.0 * mean_anchor_error(fit.calibration, *c.truth)) +
+                             " mm" +
+                             (added.empty() ? "" : format_text("; added terms %.1f sigma from the true values", worst)));
   }
   return v;
 }
