@@ -53,7 +53,7 @@ int run_diagnose(const DiagnoseArgs& args) {
   if (!inputs) return 1;
   const Robot* const robot = &inputs->robot;
   const std::vector<Sample>* const samples = &inputs->samples;
-  ReportContext context{robot->name, robot->noise, std::nullopt};
+  ReportContext context{robot->name, robot->noise, std::nullopt, robot};
   if (!args.truth_path.empty()) {
     auto truth = formats::read_truth_toml(args.truth_path);
     if (!truth) {

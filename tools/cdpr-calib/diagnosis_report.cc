@@ -4,11 +4,15 @@
 #include <cstdarg>
 #include <cstdio>
 
-#include "residual_trends.h"
-#include "svg_plot.h"
+#include "src/report/html.h"
+#include "src/report/residual_trends.h"
+#include "src/report/sections.h"
 
 namespace cdpr::tools {
 namespace {
+
+using report::residual_trends;
+using report::Trend;
 
 void append(std::string& out, const char* format, ...) __attribute__((format(printf, 2, 3)));
 void append(std::string& out, const char* format, ...) {
@@ -83,6 +87,11 @@ std::vector<Effect> added_effects(const Diagnosis& d) {
     }
   }
   return out;
+}
+
+template <typename... T>
+std::string format_text(const char* fmt, T... values) {
+  return report::format(fmt, values...);
 }
 
 // One machine-readable line for scripts (tools/diagnose-acceptance.sh).
@@ -176,7 +185,9 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
   }
   if (d.structure_remains) {
     append(out, "STRUCTURE REMAINS that no known effect explains: held-out normalized rms %.3f, p = %.2g against the "
-                "noise; see the trends above\n", last.held_out.normalized_rms(), d.structure_p_value);
+                "noise; strongest residual trend: %s\n",
+           last.held_out.normalized_rms(), d.structure_p_value,
+           report::strongest_trend_text(residual_trends(last.held_out)).c_str());
   } else {
     append(out, "no structure left above the noise (held-out normalized rms %.3f, p = %.2g)\n",
            last.held_out.normalized_rms(), d.structure_p_value);
@@ -207,63 +218,139 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
 
 namespace {
 
-// The residual plots of one step's held-out poses, grouped by residual channel.
-std::string step_plots(const HeldOutEvaluation& h, const std::string& heading) {
-  const std::vector<ResidualSeries> all = residual_series(h);
-  std::string html = "<h3>" + html_escape(heading) + "</h3><div class=\"plots\">";
-  const auto plot = [&](const std::string& prefix, const std::string& against, const std::string& title,
-                        const std::string& y_label) {
-    std::vector<PlotSeries> series;
-    for (const ResidualSeries& s : all) {
-      if (s.sensor.rfind(prefix, 0) == 0 && s.against == against) series.push_back({s.sensor, s.x, s.residual});
-    }
-    html += svg_scatter({title, against, y_label}, series);
+std::string effect_list(const std::vector<Effect>& effects) {
+  std::string text;
+  for (std::size_t k = 0; k < effects.size(); ++k) {
+    text += (k == 0 ? "" : k + 1 == effects.size() ? " and " : ", ") + std::string(effect_model_name(effects[k]));
+  }
+  return text;
+}
+
+std::vector<std::string> value_names(const std::vector<Effect>& effects) {
+  std::vector<std::string> names;
+  for (Effect e : effects) {
+    for (const std::string& name : effect_value_names(e)) names.push_back(name);
+  }
+  return names;
+}
+
+report::Verdict verdict_of(const Diagnosis& d, const ReportContext& c) {
+  report::Verdict v;
+  v.title = "Model check of robot " + c.robot_name;
+  if (!d.ok || d.steps.empty()) {
+    v.tone = report::Tone::kBad;
+    v.conclusion = "The check could not run: " + d.message;
+    return v;
+  }
+  const DiagnosisStep& first = d.steps.front();
+  const DiagnosisStep& last = d.steps.back();
+  const std::vector<Effect> added = added_effects(d);
+  if (d.structure_remains) {
+    v.tone = report::Tone::kBad;
+    v.conclusion = (added.empty() ? "" : effect_list(added) + " explains part of it, but s") +
+                   std::string(added.empty() ? "S" : "") + "tructure remains that no known term explains: " +
+                   report::strongest_trend_text(residual_trends(last.held_out));
+  } else if (!added.empty()) {
+    v.conclusion = "Explained by " + effect_list(added) + ": with it the model predicts held-out poses down to the noise";
+  } else {
+    v.conclusion = "The " + model_text(first.model) + " model explains the data: no term needed, nothing above the noise";
+  }
+  v.facts.emplace_back("model fitted", model_text(last.model) + format_text(" (%d samples, %d-fold cross-validation)",
+                                                                            d.sample_count, d.folds));
+  const CalibrationResult& fit = d.final_fit.ok ? d.final_fit : last.fit;
+  const std::string values = report::effect_values_text(fit.calibration.effects, value_names(added));
+  v.facts.emplace_back("added", added.empty() ? "nothing" : values.empty() ? effect_list(added) : values);
+  // "a -> b" when the workflow changed the model, else the one value.
+  const auto change = [&](const char* fmt, double before, double after) {
+    return d.steps.size() > 1 ? format_text(fmt, before) + " -> " + format_text(fmt, after) : format_text(fmt, after);
   };
-  plot("encoder", "cable length [m]", "encoder residual vs cable length", "residual [m]");
-  plot("encoder", "cable tension [N]", "encoder residual vs tension", "residual [m]");
-  plot("encoder", "platform height [m]", "encoder residual vs height", "residual [m]");
-  plot("height", "platform height [m]", "attachment-height residual (Eq. 15)", "residual [m]");
-  plot("load cell", "reference tension [N]", "load-cell residual vs tension", "residual [N]");
-  plot("load cell", "platform height [m]", "load-cell residual vs height", "residual [N]");
-  return html + "</div>";
+  v.facts.emplace_back(
+      "held-out misfit",
+      "normalised rms " + change("%.2f", first.held_out.normalized_rms(), last.held_out.normalized_rms()) +
+          format_text(" (1 = noise floor; structure p = %.2g); encoder rms ", d.structure_p_value) +
+          change("%.1f", 1000.0 * first.held_out.rms_encoder_m, 1000.0 * last.held_out.rms_encoder_m) +
+          format_text(" mm (noise %.1f mm), load cell ", 1000.0 * c.noise.encoder_m) +
+          change("%.2f", first.held_out.rms_force_n, last.held_out.rms_force_n) +
+          format_text(" N (noise %.2f N)", c.noise.force_n));
+  std::string anchors = c.nominal ? report::anchors_moved_text(*c.nominal, fit.calibration) : "";
+  if (!added.empty() && first.fit.ok) {
+    anchors = "the added terms moved them by " + report::anchors_shift_text(first.fit.calibration, fit.calibration) +
+              (anchors.empty() ? "" : "; " + anchors);
+  }
+  if (!anchors.empty()) v.facts.emplace_back("anchors", anchors);
+  v.facts.emplace_back("rejected", report::rejected_text(d.gross_errors));
+  if (c.truth && fit.ok) {
+    double worst = 0.0;
+    for (const std::string& name : value_names(added)) {
+      worst = std::max(worst, sigma_distance(fit.calibration.effects, c.truth->effects, name));
+    }
+    v.facts.emplace_back("against truth",
+                         "mean anchor error " +
+                             change("%.1f", 1000.0 * mean_anchor_error(first.fit.calibration, *c.truth),
+                                    1000.0 * mean_anchor_error(fit.calibration, *c.truth)) +
+                             " mm" +
+                             (added.empty() ? "" : format_text("; added terms %.1f sigma from the true values", worst)));
+  }
+  return v;
 }
 
 std::string sensor_table(const Diagnosis& d) {
-  std::string html = "<table><tr><th>step</th><th>model</th><th>normalized rms</th>";
-  for (int i = 0; i < kCableCount; ++i) html += "<th>encoder " + std::to_string(i) + " rms [m]</th>";
-  html += "<th>load cell rms [N]</th></tr>";
+  std::vector<report::Evaluation> steps;
+  std::vector<std::string> captions;
   for (std::size_t s = 0; s < d.steps.size(); ++s) {
-    const HeldOutEvaluation& h = d.steps[s].held_out;
-    std::string row;
-    append(row, "<tr><td>%zu</td><td>%s</td><td>%.3f</td>", s, html_escape(model_text(d.steps[s].model)).c_str(),
-           h.normalized_rms());
-    for (int i = 0; i < kCableCount; ++i) {
-      double sum = 0.0;
-      for (const HeldOutPose& p : h.poses) sum += std::pow(p.prediction.encoder_residual_m[i], 2);
-      append(row, "<td>%.4f</td>", std::sqrt(sum / std::max<std::size_t>(1, h.poses.size())));
-    }
-    append(row, "<td>%.2f</td></tr>", h.rms_force_n);
-    html += row;
+    captions.push_back(format_text("%zu: %s (normalised rms %.3f)", s, model_text(d.steps[s].model).c_str(),
+                                   d.steps[s].held_out.normalized_rms()));
   }
-  return html + "</table>";
+  for (std::size_t s = 0; s < d.steps.size(); ++s) steps.push_back({captions[s], &d.steps[s].held_out});
+  return report::rms_table(steps);
+}
+
+std::string candidates_table(const Diagnosis& d) {
+  std::vector<std::vector<std::string>> rows;
+  for (std::size_t s = 0; s < d.steps.size(); ++s) {
+    for (const CandidateScore& cand : d.steps[s].candidates) {
+      const std::string name(effect_model_name(cand.effect));
+      if (!cand.evaluated) {
+        rows.push_back({std::to_string(s), name, "-", "-", "-", "-", "-", cand.failure});
+        continue;
+      }
+      rows.push_back({std::to_string(s), name, format_text("%.1f", cand.held_out_drop), format_text("%+.1f", cand.t_statistic),
+                      format_text("%.1f", cand.fit_chi2_drop), format_text("%.2g", cand.fit_p_value),
+                      format_text("%.2g", cand.level), cand.significant ? "significant" : cand.failure});
+    }
+  }
+  return report::table({"step", "candidate", "held-out chi2 drop", "paired t", "fit chi2 drop", "p", "level", "verdict"},
+                       rows);
 }
 
 }  // namespace
 
 std::string diagnosis_html(const Diagnosis& d, const ReportContext& c) {
-  std::string html =
-      "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>cdpr-calib diagnose: " + html_escape(c.robot_name) +
-      "</title><style>body{font-family:sans-serif;margin:1em 2em}pre{background:#f6f6f6;padding:.8em}"
-      ".plots{display:flex;flex-wrap:wrap;gap:8px}table{border-collapse:collapse}td,th{border:1px solid #ccc;"
-      "padding:2px 6px;text-align:right}</style></head><body>";
-  html += "<h1>Model discrepancy: " + html_escape(c.robot_name) + "</h1>";
-  html += "<pre>" + html_escape(diagnosis_text(d, c)) + "</pre>";
-  if (!d.ok || d.steps.empty()) return html + "</body></html>";
-  html += "<h2>Held-out residuals per step and sensor</h2>" + sensor_table(d);
-  html += "<h2>Residual structure on held-out poses</h2>";
-  html += step_plots(d.steps.front().held_out, "before: " + model_text(d.steps.front().model));
-  if (d.steps.size() > 1) html += step_plots(d.steps.back().held_out, "after: " + model_text(d.steps.back().model));
-  return html + "</body></html>";
+  std::string html = report::page_begin("cdpr-calib diagnose: " + c.robot_name) + report::verdict_card(verdict_of(d, c));
+  if (d.ok && !d.steps.empty()) {
+    const DiagnosisStep& first = d.steps.front();
+    const DiagnosisStep& last = d.steps.back();
+    const std::string before = "before: " + model_text(first.model), after = "after: " + model_text(last.model);
+    std::vector<report::Evaluation> shown{{d.steps.size() > 1 ? before : "held out: " + model_text(first.model),
+                                           &first.held_out}};
+    if (d.steps.size() > 1) shown.push_back({after, &last.held_out});
+    html += "<h2>Held-out residuals per step and sensor</h2>" + sensor_table(d);
+    html += "<h2>Residuals of held-out poses" + std::string(d.steps.size() > 1 ? ", before and after" : "") +
+            "</h2><p>Model minus measured reading at poses each fit never saw, on shared axes. A slope, a curve or a "
+            "drift over the sample order is structure the model lacks.</p>";
+    html += report::residual_plots(shown);
+    html += "<h2>Normalised residuals</h2>";
+    if (c.nominal) html += report::histogram_plots(*c.nominal, shown);
+    const CalibrationResult& fit = d.final_fit.ok ? d.final_fit : last.fit;
+    if (c.nominal && fit.ok) html += "<h2>Anchors of the final model</h2>" + report::anchor_plots(*c.nominal, fit, c.truth);
+    html += report::details("Strongest held-out residual trends, final model",
+                            report::trends_table(residual_trends(last.held_out), 10));
+    html += report::details("Candidates of every round", candidates_table(d));
+    html += report::details(format_text("Rejected readings (%zu)", d.gross_errors.size()),
+                            report::rejected_table(d.gross_errors));
+  }
+  html += report::details("Full text report", "<pre>" + report::html_escape(diagnosis_text(d, c)) + "</pre>");
+  return html + report::page_end();
 }
 
 }  // namespace cdpr::tools

@@ -15,6 +15,7 @@ struct ReportContext {
   std::string robot_name;
   NoiseSigmas noise;
   std::optional<Truth> truth;  // simulated data: anchor errors and true effect values
+  const Robot* nominal = nullptr;  // robot.toml: anchors moved, normalised residuals, anchor plots
 };
 
 std::string diagnosis_text(const Diagnosis& diagnosis, const ReportContext& context);

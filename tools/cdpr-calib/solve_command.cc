@@ -1,14 +1,40 @@
 #include "solve_command.h"
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 
 #include "model_option.h"
 #include "input_files.h"
 #include "report.h"
 #include "src/formats/calibration_toml.h"
+#include "src/report/calibration_report.h"
 
 namespace cdpr::tools {
+namespace {
+
+// DIR/report.html of a finished calibration; false after printing why not.
+bool write_report(const SolveArgs& args, const CalibrationInputs& inputs, const CalibrationOptions& options,
+                  const CalibrationResult& result, const std::optional<Truth>& truth) {
+  const std::filesystem::path dir(args.report_dir);
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  const HeldOutEvaluation residuals = report::fitted_residuals(inputs.robot, inputs.samples, options, result);
+  report::CalibrationReport report{"Calibration of robot " + inputs.robot.name, &inputs.robot, &result, &residuals,
+                                   truth, {{"data", args.robot_path + (args.samples_path.empty() ? "" : ", " +
+                                                                       args.samples_path)}}};
+  std::ofstream out(dir / "report.html", std::ios::trunc);
+  out << report::calibration_report_html(report);
+  out.close();
+  if (ec || !out) {
+    std::fprintf(stderr, "cdpr-calib: cannot write %s\n", (dir / "report.html").c_str());
+    return false;
+  }
+  std::fprintf(stdout, "wrote %s\n", (dir / "report.html").c_str());
+  return true;
+}
+
+}  // namespace
 
 void add_solve_command(CLI::App& app, SolveArgs& args) {
   CLI::App* solve = app.add_subcommand("solve", "Calibrate anchors and encoder offsets from measured static poses");
@@ -30,6 +56,8 @@ void add_solve_command(CLI::App& app, SolveArgs& args) {
       ->check(CLI::PositiveNumber)->capture_default_str();
   solve->add_option("--truth", args.truth_path, "truth.toml of a simulated data set: print the errors against it")
       ->check(CLI::ExistingFile);
+  solve->add_option("--report", args.report_dir,
+                    "also write DIR/report.html (created): verdict, anchors with their sigma ellipses, residual plots");
   solve->add_option("--max-rejected-fraction", args.max_rejected_fraction,
                     "refuse the calibration when more than this fraction of the rows have gross errors")
       ->check(CLI::Range(0.0, 1.0))->capture_default_str();
@@ -78,14 +106,17 @@ int run_solve(const SolveArgs& args) {
   }
   std::fprintf(stdout, "wrote %s\n", args.output_path.c_str());
 
+  std::optional<Truth> truth;
   if (!args.truth_path.empty()) {
-    const auto truth = formats::read_truth_toml(args.truth_path);
-    if (!truth) {
-      std::fprintf(stderr, "cdpr-calib: %s\n", truth.error().message().c_str());
+    const auto read = formats::read_truth_toml(args.truth_path);
+    if (!read) {
+      std::fprintf(stderr, "cdpr-calib: %s\n", read.error().message().c_str());
       return 1;
     }
+    truth = *read;
     print_truth_comparison(stdout, result.calibration, *truth);
   }
+  if (!args.report_dir.empty() && !write_report(args, *inputs, options, result, truth)) return 1;
   if (result.misfit && !args.accept_misfit) {
     std::fprintf(stderr,
                  "cdpr-calib: %s\ncdpr-calib: the calibration was written but is not to be trusted as it is; "

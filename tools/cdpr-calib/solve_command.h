@@ -14,6 +14,7 @@ struct SolveArgs {
   std::string samples_path;
   std::string output_path = "calibration.toml";
   std::string truth_path;  // optional: compare with a simulator's truth.toml
+  std::string report_dir;  // optional: write report.html there
   std::string model = "catenary";
   double huber_width = 0.0;
   double height_sigma_m = 1e-2;

@@ -39,6 +39,29 @@ bool parse_list(const std::string& text, std::size_t count, std::vector<double>&
   return out.size() == count;
 }
 
+// "0:0.05,3:-0.05" -> drift[0] = 0.05, drift[3] = -0.05.
+bool parse_drift(const std::string& text, std::array<double, cdpr::kCableCount>& drift) {
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    const std::string field = text.substr(start, comma - start);
+    const std::size_t colon = field.find(':');
+    if (colon == std::string::npos) return false;
+    try {
+      std::size_t used_cable = 0, used_value = 0;
+      const int cable = std::stoi(field.substr(0, colon), &used_cable);
+      const double value = std::stod(field.substr(colon + 1), &used_value);
+      if (used_cable != colon || used_value != field.size() - colon - 1) return false;
+      if (cable < 0 || cable >= cdpr::kCableCount) return false;
+      drift[static_cast<std::size_t>(cable)] = value;
+    } catch (const std::exception&) {
+      return false;
+    }
+    start = comma + 1;
+  }
+  return true;
+}
+
 bool write_file(const std::filesystem::path& path, const std::string& text) {
   std::ofstream file(path, std::ios::binary | std::ios::trunc);
   file << text;
@@ -53,7 +76,7 @@ bool write_file(const std::filesystem::path& path, const std::string& text) {
 struct Args {
   std::string preset = "large";
   std::string out_dir;
-  std::string encoder_scale, com_offset, wind, workspace;
+  std::string encoder_scale, encoder_drift, com_offset, wind, workspace;
   std::string encoder_outlier_range = "0.5,2", force_spike_range = "50,500";
   std::uint64_t seed = 1;
 };
@@ -82,6 +105,9 @@ int main(int argc, char** argv) {
   app.add_option("--encoder-scale", args.encoder_scale,
                  "hidden encoder scale s: one value for all cables or 4 comma-separated; "
                  "reading = (1 + s) * payout + offset");
+  app.add_option("--encoder-drift", args.encoder_drift,
+                 "unknown effect: encoders drifting over the run, CABLE:METRES[,CABLE:METRES...]; the reading of "
+                 "sample k of n gains METRES * k / (n - 1) (e.g. 0:0.05,3:-0.05)");
   app.add_option("--force-bias", config.effects.force_bias_n, "hidden load-cell bias b [N]: reading = (1 + g) * tension + b");
   app.add_option("--force-gain", config.effects.force_gain, "hidden load-cell gain error g");
   app.add_option("--com-offset", args.com_offset, "hidden centre-of-mass offset x,y,z [m, platform frame]");
@@ -124,6 +150,11 @@ int main(int argc, char** argv) {
       return 1;
     }
     std::copy(values.begin(), values.end(), config.effects.encoder_scale.begin());
+  }
+  if (!args.encoder_drift.empty() && !parse_drift(args.encoder_drift, config.effects.encoder_drift_m)) {
+    std::fprintf(stderr, "cdpr-sim: --encoder-drift: expected CABLE:METRES[,CABLE:METRES...] with CABLE 0 to %d\n",
+                 cdpr::kCableCount - 1);
+    return 1;
   }
   for (auto [text, target, name] : {std::tuple{&args.com_offset, &config.effects.com_offset_platform, "--com-offset"},
                                     std::tuple{&args.wind, &config.effects.wind_force_world_n, "--wind"}}) {

@@ -101,6 +101,12 @@ Expected<SimulatedDataset, std::string> simulate_dataset(const DatasetConfig& co
         measure(data.true_robot, f.state, config.noise_scale, noise, static_cast<int>(data.samples.size())));
     data.states.push_back(f.state);
   }
+  // After the noise, so a seed's noise is the same with and without a drift.
+  const std::array<double, kCableCount>& drift = data.true_robot.effects.encoder_drift_m;
+  const double last = static_cast<double>(std::max<std::size_t>(1, data.samples.size() - 1));
+  for (std::size_t k = 0; k < data.samples.size(); ++k) {
+    for (int i = 0; i < kCableCount; ++i) data.samples[k].encoder_m[i] += drift[i] * static_cast<double>(k) / last;
+  }
   data.truth.outliers = plant_gross_errors(config.gross_errors, config.seed, data.nominal.reference_cable, data.samples);
   return data;
 }

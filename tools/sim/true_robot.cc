@@ -15,6 +15,9 @@ EffectValues effect_values(const HiddenEffects& e) {
   bool any_scale = false;
   for (double s : e.encoder_scale) any_scale = any_scale || s != 0.0;
   if (any_scale) values["encoder_scale"] = {e.encoder_scale.begin(), e.encoder_scale.end()};
+  bool any_drift = false;
+  for (double d : e.encoder_drift_m) any_drift = any_drift || d != 0.0;
+  if (any_drift) values["encoder_drift"] = {e.encoder_drift_m.begin(), e.encoder_drift_m.end()};
   if (e.force_bias_n != 0.0) values["force_bias"] = {e.force_bias_n};
   if (e.force_gain != 0.0) values["force_gain"] = {e.force_gain};
   if (!e.com_offset_platform.isZero(0.0)) values["com_offset"] = values_of(e.com_offset_platform);

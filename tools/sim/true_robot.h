@@ -19,6 +19,10 @@ struct HiddenEffects {
   double axial_stiffness_n = std::numeric_limits<double>::infinity();
   // Encoder scale s_i: reading = (1 + s_i) * payout + offset_i.
   std::array<double, kCableCount> encoder_scale{};
+  // Encoder drift d_i [m] over the run (a slipping encoder): reading of
+  // sample k of n += d_i * k / (n - 1), linear in sample order. No model
+  // term describes it.
+  std::array<double, kCableCount> encoder_drift_m{};
   // Load cell: reading = (1 + gain) * tension + bias.
   double force_bias_n = 0.0;
   double force_gain = 0.0;
@@ -51,7 +55,7 @@ struct TrueRobot {
 };
 
 // The [effects] table of truth.toml (docs/FORMATS.md): only effects that are
-// present, by name: axial_stiffness [N], encoder_scale (4), force_bias [N],
+// present, by name: axial_stiffness [N], encoder_scale (4), encoder_drift (4) [m], force_bias [N],
 // force_gain, com_offset (3) [m], density_error, pulley_radius [m],
 // wind_force (3) [N].
 EffectValues effect_values(const HiddenEffects& effects);
