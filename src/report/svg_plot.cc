@@ -164,7 +164,7 @@ std::string svg_scatter(const PlotSpec& spec, const std::vector<PlotSeries>& ser
   for (const PlotSeries& s : series) {
     for (std::size_t j = 0; j < s.x.size() && j < s.y.size(); ++j) {
       if (!std::isfinite(s.x[j]) || !std::isfinite(s.y[j]) || !frame.inside(s.x[j], s.y[j])) continue;
-      frame.svg() += "<circle cx=\"" + num(frame.px(s.x[j])) + "\" cy=\"" + num(frame.py(s.y[j])) +
+      frame.svg() += "<circle class=\"data\" cx=\"" + num(frame.px(s.x[j])) + "\" cy=\"" + num(frame.py(s.y[j])) +
                      "\" r=\"2.4\" fill=\"" + series_colour(s.colour) + "\" fill-opacity=\"0.8\"/>";
     }
   }
@@ -187,7 +187,7 @@ std::string svg_normal_histogram(const PlotSpec& spec, const std::vector<double>
     if (density[k] <= 0.0) continue;
     const double x0 = -kHistogramEdge + kBinWidth * static_cast<double>(k);
     const double top = std::min(density[k], y.hi);
-    frame.svg() += "<rect x=\"" + num(frame.px(x0)) + "\" y=\"" + num(frame.py(top)) + "\" width=\"" +
+    frame.svg() += "<rect class=\"data\" x=\"" + num(frame.px(x0)) + "\" y=\"" + num(frame.py(top)) + "\" width=\"" +
                    num(frame.px(x0 + kBinWidth) - frame.px(x0)) + "\" height=\"" + num(frame.py(0.0) - frame.py(top)) +
                    "\" fill=\"" + series_colour(colour) + "\" fill-opacity=\"0.55\" stroke=\"#fff\"/>";
   }
@@ -224,10 +224,10 @@ std::string svg_anchor_top_view(const AnchorTopView& a, double half_width_m) {
     for (std::size_t j = 0; j < points.size(); ++j) {
       path += (j ? " L" : "M") + num(frame.px(points[j].x())) + "," + num(frame.py(points[j].y()));
     }
-    frame.svg() += "<path d=\"" + path + " Z\" fill=\"none\" stroke=\"" + series_colour(a.colour) + "\"" +
+    frame.svg() += "<path class=\"data\" d=\"" + path + " Z\" fill=\"none\" stroke=\"" + series_colour(a.colour) + "\"" +
                    (k > 1.0 ? " stroke-dasharray=\"4,3\"" : "") + "/>";
   }
-  frame.svg() += "<circle cx=\"" + num(frame.px(0)) + "\" cy=\"" + num(frame.py(0)) + "\" r=\"3\" fill=\"" +
+  frame.svg() += "<circle class=\"data\" cx=\"" + num(frame.px(0)) + "\" cy=\"" + num(frame.py(0)) + "\" r=\"3\" fill=\"" +
                  series_colour(a.colour) + "\"/>";
   const auto mark = [&](const Eigen::Vector2d& world, int colour, const char* name, int row) {
     const Eigen::Vector2d p = point(world);
@@ -271,9 +271,9 @@ std::string svg_anchor_layout(const std::vector<AnchorTopView>& anchors) {
   Frame frame(spec, t, t, legend);
   for (const AnchorTopView& a : anchors) {
     const char* c = series_colour(a.colour);
-    frame.svg() += "<circle cx=\"" + num(frame.px(a.nominal.x())) + "\" cy=\"" + num(frame.py(a.nominal.y())) +
+    frame.svg() += "<circle class=\"data\" cx=\"" + num(frame.px(a.nominal.x())) + "\" cy=\"" + num(frame.py(a.nominal.y())) +
                    "\" r=\"5\" fill=\"none\" stroke=\"" + c + "\" stroke-width=\"1.5\"/>";
-    frame.svg() += "<circle cx=\"" + num(frame.px(a.fitted.x())) + "\" cy=\"" + num(frame.py(a.fitted.y())) +
+    frame.svg() += "<circle class=\"data\" cx=\"" + num(frame.px(a.fitted.x())) + "\" cy=\"" + num(frame.py(a.fitted.y())) +
                    "\" r=\"3\" fill=\"" + c + "\"/>";
   }
   return frame.finish();

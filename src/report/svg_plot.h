@@ -9,7 +9,9 @@
 // frame widened to the ticks so no point is clipped, a zero line, one colour
 // per cable (series colour = cable index), the legend in a column right of
 // the frame, never over the data. A viewBox and max-width: 100% let the
-// page scale each plot down to the screen or the A4 page.
+// page scale each plot down to the screen or the A4 page. Data marks carry
+// class="data", so the browser check (tools/check-report) can tell an empty
+// plot from one whose only shapes are its legend and reference curves.
 
 #include <optional>
 #include <string>

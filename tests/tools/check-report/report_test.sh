@@ -33,6 +33,20 @@ case $kind in
     simulate --seed 11 --wind 100,60,0
     "$calib" diagnose "$out/data/robot.toml" "$out/data/samples.csv" -o "$out/report" >"$out/diagnose.txt" 2>&1
     report=$out/report/report.html ;;
+  diagnose-drift)  # structure remains, named as a trend over sample order
+    simulate --seed 21 --encoder-drift 0:0.06,3:-0.06
+    "$calib" diagnose "$out/data/robot.toml" "$out/data/samples.csv" -o "$out/report" >"$out/diagnose.txt" 2>&1
+    report=$out/report/report.html ;;
+  solve)  # a plain calibration: the verdict card, anchors and residuals
+    simulate --seed 12
+    "$calib" solve -q "$out/data/robot.toml" "$out/data/samples.csv" -o "$out/calibration.toml" \
+      --report "$out/report" >"$out/solve.txt" 2>&1
+    report=$out/report/report.html ;;
+  solve-misfit)  # the model does not fit: the card says so and points to diagnose
+    simulate --seed 21 --encoder-drift 0:0.06,3:-0.06
+    "$calib" solve -q "$out/data/robot.toml" "$out/data/samples.csv" -o "$out/calibration.toml" \
+      --accept-misfit --report "$out/report" >"$out/solve.txt" 2>&1
+    report=$out/report/report.html ;;
   *)
     echo "unknown report kind $kind" >&2
     exit 2 ;;
