@@ -142,6 +142,8 @@ class CalibrationStateMachine {
   // The fit of the current or last run once validation accepted it, with
   // created/robot/samples filled in; null before that and after a refusal.
   const Calibration* validated_fit() const { return fit_validated_ ? &solve_result_->calibration : nullptr; }
+  // The whole result behind validated_fit() (covariance, rejected readings), for its report.
+  const CalibrationResult* validated_result() const { return fit_validated_ ? &*solve_result_ : nullptr; }
 
   const CalibrationStatus& status() const { return status_; }
   const WaypointPlan& plan() const { return plan_; }

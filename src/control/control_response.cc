@@ -1,6 +1,7 @@
 #include "src/control/control_response.h"
 
 #include <cmath>
+#include <filesystem>
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
@@ -167,6 +168,14 @@ std::string format_show_response(const std::optional<store::CurrentCalibration>&
       entry["skipped"] = run->log.skipped;
       entry["robot_time_s"] = run->log.robot_time_s;
       entry["diagnosis"] = run->log.diagnosis;
+      // The report beside the calibration; null when the run has none (an older daemon's).
+      const std::string report = run->path + "/" + store::RunHistory::kReportName;
+      std::error_code error;
+      if (std::filesystem::is_regular_file(report, error)) {
+        entry["report"] = report;
+      } else {
+        entry["report"] = nullptr;
+      }
       json["run"] = std::move(entry);
     }
   }

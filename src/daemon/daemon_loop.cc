@@ -39,7 +39,8 @@ DaemonLoop::DaemonLoop(const DaemonConfig& config, const Robot& robot, DaemonDev
     model_check->fit = config_.solver;
   }
   recorder_ = std::make_unique<RunRecorder>(
-      store_.state_dir(), static_cast<std::uintmax_t>(config_.history.budget_mb * kBytesPerMb), model_check);
+      store_.state_dir(), static_cast<std::uintmax_t>(config_.history.budget_mb * kBytesPerMb), model_check,
+      config_.solver);
 }
 
 DaemonLoop::~DaemonLoop() { shutdown(); }

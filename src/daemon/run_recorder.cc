@@ -1,5 +1,6 @@
 #include "src/daemon/run_recorder.h"
 
+#include <cstdio>
 #include <filesystem>
 #include <utility>
 
@@ -8,6 +9,7 @@
 #include "src/formats/calibration_toml.h"
 #include "src/formats/robot_toml.h"
 #include "src/formats/samples_csv.h"
+#include "src/report/calibration_report.h"
 #include "src/store/atomic_file.h"
 #include "src/store/calibration_store.h"
 #include "src/store/pending_calibration.h"
@@ -15,11 +17,12 @@
 namespace cdpr::daemon {
 
 RunRecorder::RunRecorder(std::string state_dir, std::uintmax_t budget_bytes,
-                         std::optional<DiagnosisOptions> model_check)
+                         std::optional<DiagnosisOptions> model_check, std::optional<CalibrationOptions> report_fit)
     : history_(state_dir + "/" + store::CalibrationStore::kHistoryDir),
       state_dir_(std::move(state_dir)),
       budget_bytes_(budget_bytes),
       model_check_(std::move(model_check)),
+      report_fit_(std::move(report_fit)),
       writer_([this] { writer_loop(); }) {}
 
 RunRecorder::~RunRecorder() { finish(); }
@@ -125,6 +128,7 @@ void RunRecorder::track(calibration::CalibrationStateMachine& machine, const Rob
     run_ = next_run_++;
     waypoints_queued_ = faults_queued_ = 0;
     fit_queued_ = solved_ = false;
+    report_result_.reset();
     outcome_queued_.clear();
     machine.note_run_entry(history_.entry_path(run_));
     post([this, run = run_, robot_text = formats::format_robot_toml(robot)] {
@@ -147,13 +151,15 @@ void RunRecorder::track(calibration::CalibrationStateMachine& machine, const Rob
   if (machine.validated_fit() && !fit_queued_) {
     fit_queued_ = true;
     fit_text = formats::format_calibration_toml(*machine.validated_fit());
+    if (report_fit_ && machine.validated_result()) report_result_ = *machine.validated_result();
   }
   formats::RunLog snapshot = log;
   snapshot.run = run_;
   const bool ended = log.outcome != formats::kRunRunning;
   const bool check = ended && solved_ && model_check_.has_value();
+  const bool with_report = ended && report_result_.has_value();
   std::vector<Sample> samples;
-  if (samples_changed || check) samples = machine.samples();
+  if (samples_changed || check || with_report) samples = machine.samples();
   // Copies: the model check below needs them too.
   post([this, run = run_, snapshot, samples, samples_changed,
         fit_text = std::move(fit_text), ended] {
@@ -168,6 +174,12 @@ void RunRecorder::track(calibration::CalibrationStateMachine& machine, const Rob
     write(store::RunHistory::kLogName, formats::format_run_log_toml(snapshot));
     if (ended) prune();
   });
+  if (with_report) {
+    post([this, run = run_, snapshot, robot, samples, fit = std::move(*report_result_)] {
+      write_report(run, snapshot, robot, samples, fit);
+    });
+    report_result_.reset();
+  }
   if (check) {
     post([this, run = run_, snapshot = std::move(snapshot), robot, samples = std::move(samples)] {
       check_model(run, snapshot, robot, samples);
@@ -191,6 +203,44 @@ void RunRecorder::check_model(int run, formats::RunLog log, const Robot& robot, 
   }
   std::lock_guard lock(mutex_);
   messages_.push_back("model check of " + store::RunHistory::entry_name(run) + ": " + log.diagnosis);
+}
+
+namespace {
+
+std::string seconds_text(double s) {
+  char text[48];
+  std::snprintf(text, sizeof text, "%.0f s (%.1f min)", s, s / 60.0);
+  return text;
+}
+
+// The run's facts the report's card shows: time, waypoints, why some were skipped.
+std::vector<std::pair<std::string, std::string>> run_facts(const formats::RunLog& log) {
+  std::vector<std::pair<std::string, std::string>> facts;
+  facts.emplace_back("run", store::RunHistory::entry_name(log.run) + ", " + log.outcome + ", started " + log.started);
+  facts.emplace_back("robot time", seconds_text(log.robot_time_s));
+  facts.emplace_back("waypoints", std::to_string(log.waypoints_planned) + " planned, " + std::to_string(log.samples) +
+                                      " sampled, " + std::to_string(log.skipped) + " skipped");
+  for (const formats::RunWaypoint& w : log.waypoints) {
+    if (w.outcome != "skipped") continue;
+    facts.emplace_back("skipped waypoint " + std::to_string(w.index), w.why);
+  }
+  return facts;
+}
+
+}  // namespace
+
+void RunRecorder::write_report(int run, const formats::RunLog& log, const Robot& robot,
+                               const std::vector<Sample>& samples, const CalibrationResult& fit) {
+  // A run pruned meanwhile (a budget of nothing) has no entry to write into.
+  std::error_code error;
+  if (!std::filesystem::is_directory(history_.entry_path(run), error)) return;
+  const HeldOutEvaluation residuals = report::fitted_residuals(robot, samples, *report_fit_, fit);
+  const report::CalibrationReport content{"Calibration of robot " + robot.name, &robot, &fit, &residuals,
+                                          std::nullopt, run_facts(log)};
+  if (auto written = history_.write(run, store::RunHistory::kReportName, report::calibration_report_html(content));
+      !written) {
+    report("run history: " + written.error().message());
+  }
 }
 
 }  // namespace cdpr::daemon

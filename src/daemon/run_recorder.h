@@ -8,7 +8,10 @@
 // calibration's run and a fit waiting in pending/. When the run reached its
 // solve and a model check is configured, the check (solver/diagnosis) runs
 // on the run's samples and its verdict (model_check_verdict.h) is added to
-// run.toml; the calibration committed is not changed by it.
+// run.toml; the calibration committed is not changed by it. A run whose
+// fit was validated also gets report.html (src/report/calibration_report.h:
+// the verdict card with the run's robot time and waypoints, the anchors,
+// the residuals) when it ends.
 //
 // The writes (each several fsyncs) run in order on a thread of their own,
 // so that a slow or full disk (or a long model check) never stalls the loop
@@ -43,8 +46,11 @@ class RunRecorder {
   // `state_dir`: the store's (its history/ holds the entries, its
   // calibration.toml and pending/ are what pruning spares).
   // `model_check`: the options of the check after each solve; none: no check.
+  // `report_fit`: the solver options the fits were made with, for the
+  // report's residuals; none: no report.
   RunRecorder(std::string state_dir, std::uintmax_t budget_bytes,
-              std::optional<DiagnosisOptions> model_check = std::nullopt);
+              std::optional<DiagnosisOptions> model_check = std::nullopt,
+              std::optional<CalibrationOptions> report_fit = std::nullopt);
   ~RunRecorder();  // finish()
   RunRecorder(const RunRecorder&) = delete;
   RunRecorder& operator=(const RunRecorder&) = delete;
@@ -78,11 +84,15 @@ class RunRecorder {
   void prune();
   // On the writer thread: the model check of a finished run, its verdict into run.toml.
   void check_model(int run, formats::RunLog log, const Robot& robot, const std::vector<Sample>& samples);
+  // On the writer thread: report.html of a run that ended with a validated fit.
+  void write_report(int run, const formats::RunLog& log, const Robot& robot, const std::vector<Sample>& samples,
+                    const CalibrationResult& fit);
 
   store::RunHistory history_;
   std::string state_dir_;
   std::uintmax_t budget_bytes_;
   std::optional<DiagnosisOptions> model_check_;
+  std::optional<CalibrationOptions> report_fit_;
 
   // Loop thread: what of the tracked run has been queued.
   hal::TimeUs run_started_us_ = -1;
@@ -93,6 +103,7 @@ class RunRecorder {
   std::string outcome_queued_;
   bool fit_queued_ = false;
   bool solved_ = false;  // the run reached its solve
+  std::optional<CalibrationResult> report_result_;  // the run's validated fit, for its report
 
   std::mutex mutex_;
   std::condition_variable wake_;

@@ -6,6 +6,7 @@
 //   history/run-000007/samples.csv       the samples it measured (docs/FORMATS.md)
 //   history/run-000007/run.toml          its log: waypoints, skips and why, faults, robot time, outcome
 //   history/run-000007/calibration.toml  the fit it validated (absent when none)
+//   history/run-000007/report.html       that fit's report (absent when none)
 //
 // Runs are numbered on their own (a failed run has no calibration sequence
 // number); run.toml's `calibration` names the history version a run
@@ -51,6 +52,7 @@ class RunHistory {
   static constexpr const char* kSamplesName = "samples.csv";
   static constexpr const char* kRobotName = "robot.toml";
   static constexpr const char* kCalibrationName = "calibration.toml";
+  static constexpr const char* kReportName = "report.html";
 
   // `history_dir`: the store's history directory (CalibrationStore::history_dir()).
   explicit RunHistory(std::string history_dir) : dir_(std::move(history_dir)) {}

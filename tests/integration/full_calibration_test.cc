@@ -87,6 +87,9 @@ TEST(FullCalibration, LargeRobotWith35WaypointsFindsTheAnchorsWithin10cm) {
   const auto fit = store::read_file(entry + "/" + store::RunHistory::kCalibrationName);
   ASSERT_TRUE(fit);
   EXPECT_EQ(*fit, (*current)->text);
+  const auto report = store::read_file(entry + "/" + store::RunHistory::kReportName);
+  ASSERT_TRUE(report) << "no report.html beside the committed calibration";
+  EXPECT_NE(report->find("Calibration of robot"), std::string::npos);
   // AND `cdpr-calib solve <entry>` finds the committed anchors again from it
   const std::string refit = rig.dir + "/refit.toml";
   const std::string command = built_program("tools/cdpr-calib/cdpr-calib") + " solve " + entry + " -o " + refit +

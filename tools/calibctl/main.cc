@@ -33,6 +33,7 @@ struct Options {
   bool follow = false;
   int interval_ms = 500;
   int seq = 0;
+  bool report_path = false;
 };
 
 // A failure: on stderr for the operator and, with --json, on stdout as one
@@ -114,7 +115,9 @@ int main(int argc, char** argv) {
   status->add_flag("--follow,-f", options.follow, "show progress until the run ends (exit 1 if it fails)");
   status->add_option("--interval", options.interval_ms, "poll interval of --follow [ms]")
       ->check(CLI::Range(50, 60'000))->capture_default_str();
-  app.add_subcommand("show", "the current calibration");
+  auto* show = app.add_subcommand("show", "the current calibration");
+  show->add_flag("--report", options.report_path,
+                 "print only the path of its report.html (in its run's history entry); exit 1 when it has none");
   app.add_subcommand("history", "the stored calibrations, newest first (* = current)");
   app.add_subcommand("commit",
                      "commit the calibration a failed commit kept in <state>/pending, once its cause is fixed");
@@ -141,6 +144,13 @@ int main(int argc, char** argv) {
     std::printf("%s\n", raw.c_str());
   } else if (command == "status") {
     std::printf("%s", render_status(*response).c_str());
+  } else if (command == "show" && options.report_path) {
+    const JsonValue run = (*response)["run"];
+    if (run.is_null() || run["report"].is_null()) {
+      report_failure(false, "the current calibration has no report (none committed, or committed by an older daemon)");
+      return kExitRefused;
+    }
+    std::printf("%s\n", run["report"].string().c_str());
   } else if (command == "show") {
     std::printf("%s", render_show(*response).c_str());
   } else if (command == "history") {

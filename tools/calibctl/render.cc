@@ -95,6 +95,7 @@ std::string render_show(const JsonValue& s) {
                   run["samples"].integer(), run["skipped"].integer(), run["robot_time_s"].number(),
                   run["entry"].string().c_str());
     if (!run["diagnosis"].string().empty()) out += "model check: " + run["diagnosis"].string() + "\n";
+    if (!run["report"].is_null()) out += "report: " + run["report"].string() + "\n";
   }
   return out;
 }

@@ -33,8 +33,9 @@ std::string joined(const std::vector<std::string>& lines) {
 
 class RecordedRig {
  public:
-  explicit RecordedRig(std::uintmax_t budget_bytes = 1'000'000'000)
-      : recorder(std::make_unique<RunRecorder>(rig.store.state_dir(), budget_bytes)) {
+  explicit RecordedRig(std::uintmax_t budget_bytes = 1'000'000'000,
+                       std::optional<CalibrationOptions> report_fit = std::nullopt)
+      : recorder(std::make_unique<RunRecorder>(rig.store.state_dir(), budget_bytes, std::nullopt, report_fit)) {
     for (std::string& message : recorder->recover("2026-11-23T08:00:00Z", "died")) messages.push_back(message);
   }
   bool run_until(const std::function<bool()>& done) {
@@ -143,6 +144,28 @@ TEST(RunRecorder, ARunTheDaemonDidNotFinishIsFoundInterruptedAtTheNextStart) {
   EXPECT_EQ(log.reason, "run interrupted at waypoint 3 of 6");
   EXPECT_EQ(log.samples, 2);
   EXPECT_EQ(*next.history().next_run(), 2);
+}
+
+TEST(RunRecorder, ACommittedRunGetsItsReportBesideTheFit) {
+  // GIVEN the recorder as the daemon makes it (the solver's options for the report's residuals)
+  RecordedRig r(1'000'000'000, CalibrationOptions{});
+  // WHEN a calibration runs to its commit
+  ASSERT_TRUE(r.run_to_end());
+  ASSERT_EQ(r.rig.status().state, CalibrationState::kDone) << r.rig.status().reason;
+  // THEN report.html is in the entry: the verdict card of the fit and the run's facts
+  const auto report = store::read_file(r.entry(1) + "/report.html");
+  ASSERT_TRUE(report) << joined(r.messages);
+  EXPECT_TRUE(contains(*report, "<!DOCTYPE html>")) << report->substr(0, 200);
+  EXPECT_TRUE(contains(*report, "robot time"));
+  EXPECT_TRUE(contains(*report, "run-000001, committed"));
+  // AND WHEN a run is aborted before its fit THEN its entry has no report
+  r.rig.button.press();
+  ASSERT_TRUE(r.run_until([&] { return r.rig.status().samples == 1; }));
+  r.rig.machine->request_abort(r.rig.clock.now_us());
+  ASSERT_TRUE(r.run_until([] { return true; }));
+  r.settle();
+  EXPECT_TRUE(std::filesystem::exists(r.entry(2) + "/run.toml"));
+  EXPECT_FALSE(std::filesystem::exists(r.entry(2) + "/report.html"));
 }
 
 TEST(RunRecorder, TheBudgetPrunesOlderRunsButNeverTheCurrentCalibrationsNorTheLast) {
