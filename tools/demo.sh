@@ -13,7 +13,10 @@
 # (the daemon first, so it never sees its robot vanish). Exits non-zero when
 # the calibration is not committed or an anchor is 0.10 m or more off.
 # DEMO_SEED picks the virtual robot (default 7); DEMO_KEEP=DIR copies the
-# committed calibration.toml and the robot's truth.toml there.
+# committed calibration.toml and the robot's truth.toml there, and the
+# daemon's history (each run's samples, log and model check) to DIR/history.
+# DEMO_EFFECTS adds virtual-robot options, e.g. a hidden effect such as
+# "--force-bias 15" or "--axial-stiffness 1.5e6" (virtual-robot --help).
 set -euo pipefail
 build=$(cd "${1:-build}" && pwd)
 work=$(mktemp -d /tmp/cdpr-demo.XXXXXX)
@@ -50,7 +53,7 @@ start=$(date +%s)
 echo "== virtual robot: large preset (240 x 220 x 50 m, 34 kg platform), physics 20x real time,"
 echo "   nominal anchors in robot.toml 0.3 m off the truth, encoder offsets unknown"
 "$build/tools/virtual-robot/virtual-robot" --preset large --seed "${DEMO_SEED:-7}" --time-scale 20 --anchor-perturbation 0.3 \
-  --modbus-transport rtu --load-cell-model flintec-ft-11 \
+  --modbus-transport rtu --load-cell-model flintec-ft-11 ${DEMO_EFFECTS:-} \
   --endpoints "$work/robot" >"$work/virtual-robot.log" 2>&1 &
 pids+=($!)
 wait_for "$work/robot/ready" 60
@@ -97,6 +100,7 @@ echo "== calibctl show"
 if [[ -n ${DEMO_KEEP:-} ]]; then
   mkdir -p "$DEMO_KEEP"
   cp "$work/state/calibration.toml" "$work/robot/truth.toml" "$work/robot/robot.toml" "$DEMO_KEEP/"
+  [[ -d $work/state/history ]] && cp -r "$work/state/history" "$DEMO_KEEP/"
 fi
 echo "== against the virtual robot's truth"
 awk '

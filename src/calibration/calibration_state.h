@@ -51,6 +51,9 @@ struct CalibrationStatus {
   // run.toml: "running", "committed", "failed", "aborted"; empty before a run.
   std::string run_entry;
   std::string run_outcome;
+  // The model check's one-line verdict on the last run's data
+  // (model_check_verdict.h), once the owner has it; empty before.
+  std::string run_diagnosis;
 
   // Kept across runs (not reset by a start):
   std::vector<std::string> store_problems;  // what the last store check found unreadable

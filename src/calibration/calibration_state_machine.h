@@ -136,6 +136,8 @@ class CalibrationStateMachine {
   // The owner names the history entry that keeps the current run's data
   // (status().run_entry); empty when it could not make one.
   void note_run_entry(std::string path) { status_.run_entry = std::move(path); }
+  // The owner's model check of the last run's data (status().run_diagnosis).
+  void note_run_diagnosis(std::string verdict) { status_.run_diagnosis = std::move(verdict); }
 
   // The current or last run's log; `run` is the owner's to fill in.
   const formats::RunLog& run_log() const { return run_log_; }

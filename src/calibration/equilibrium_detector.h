@@ -55,7 +55,11 @@ namespace cdpr::calibration {
 
 struct EquilibriumThresholds {
   hal::TimeUs window_us = 2'000'000;      // rest window [us]
-  int min_samples = 20;                   // observations in the window, >= kRateBins
+  // Observations in the window, >= kRateBins. 100 is what the 2 s window
+  // holds at the daemon's 50 Hz loop, so a source that delivers fewer poses
+  // per second of its own time (a slower localization system, a
+  // time-scaled simulation) still averages as many readings into a row.
+  int min_samples = 100;
   double max_speed_mps = 0.002;           // platform speed [m/s]
   double max_angular_rate_radps = 0.002;  // platform angular rate [rad/s]
   double max_tension_std_n = 10.0;        // tension standard deviation [N]

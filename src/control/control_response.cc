@@ -113,6 +113,7 @@ std::string format_status_response(const calibration::CalibrationStatus& status,
     run["entry"] = status.run_entry;
     run["outcome"] = status.run_outcome;
     run["samples"] = status.samples;
+    run["diagnosis"] = status.run_diagnosis;
     json["run"] = std::move(run);
   }
   return line(json);

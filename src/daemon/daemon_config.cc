@@ -135,8 +135,8 @@ Table<CalibratorOptions> equilibrium_table() {
   Table<CalibratorOptions> t("equilibrium");
   t.duration("window_s", [](auto& o) -> auto& { return o.equilibrium.window_us; }, 2.0, kS,
              "rest window averaged into one sample row, in the pose source's own time");
-  t.integer("min_samples", [](auto& o) -> auto& { return o.equilibrium.min_samples; }, 20, {4, 1'000'000}, "",
-            "poses in the window; it reaches further back to hold them");
+  t.integer("min_samples", [](auto& o) -> auto& { return o.equilibrium.min_samples; }, 100, {4, 1'000'000}, "",
+            "poses in the window; it reaches further back to hold them (100: the 2 s window at the 50 Hz loop)");
   t.number("max_speed", [](auto& o) -> auto& { return o.equilibrium.max_speed_mps; }, 0.002, kPositive, "m/s",
            "platform speed");
   t.number("max_angular_rate", [](auto& o) -> auto& { return o.equilibrium.max_angular_rate_radps; }, 0.002,

@@ -140,6 +140,10 @@ void RunRecorder::track(calibration::CalibrationStateMachine& machine, const Rob
     });
   }
   solved_ = solved_ || status.state == calibration::CalibrationState::kSolve;
+  if (status.run_diagnosis.empty()) {
+    std::lock_guard lock(mutex_);
+    if (checked_run_ == run_ && !checked_verdict_.empty()) machine.note_run_diagnosis(checked_verdict_);
+  }
   const bool changed = log.waypoints.size() != waypoints_queued_ || log.faults.size() != faults_queued_ ||
                        log.outcome != outcome_queued_ || (machine.validated_fit() && !fit_queued_);
   if (!changed) return;
@@ -203,6 +207,8 @@ void RunRecorder::check_model(int run, formats::RunLog log, const Robot& robot, 
   }
   std::lock_guard lock(mutex_);
   messages_.push_back("model check of " + store::RunHistory::entry_name(run) + ": " + log.diagnosis);
+  checked_run_ = run;
+  checked_verdict_ = log.diagnosis;
 }
 
 namespace {

@@ -61,7 +61,8 @@ class RunRecorder {
   std::vector<std::string> recover(const std::string& finished, const std::string& why);
 
   // After every step of `machine`: queues the writes the run's progress
-  // calls for and names the entry in the machine's status.
+  // calls for, names the entry in the machine's status and, once the model
+  // check of its run is done, puts its verdict there too.
   void track(calibration::CalibrationStateMachine& machine, const Robot& robot);
 
   // Failed writes and prunings since the last call, one sentence each.
@@ -112,6 +113,8 @@ class RunRecorder {
   bool busy_ = false;
   bool stopping_ = false;
   std::vector<std::string> messages_;
+  int checked_run_ = 0;          // the run of the latest model check done
+  std::string checked_verdict_;  // and its verdict
   std::set<std::string> reported_;  // this run's, writer thread only
   std::thread writer_;
 };

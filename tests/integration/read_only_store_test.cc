@@ -44,17 +44,6 @@ bool remount(pid_t pid, const std::string& dir, const char* mode) {
   return std::system(command.c_str()) == 0;
 }
 
-calibctl::JsonValue wait_for_end(const VirtualRobotProcess& rig, std::chrono::seconds timeout) {
-  calibctl::JsonValue status;
-  wait_until(
-      [&] {
-        status = rig.ask("status");
-        return status["ok"].boolean() && !status["running"].boolean();
-      },
-      timeout);
-  return status;
-}
-
 bool contains(const std::string& text, const std::string& words) { return text.find(words) != std::string::npos; }
 
 TEST(ReadOnlyStore, ReadOnlyFromTheStartTheRunIsRefusedBeforeAnythingMoves) {
@@ -68,7 +57,7 @@ TEST(ReadOnlyStore, ReadOnlyFromTheStartTheRunIsRefusedBeforeAnythingMoves) {
   std::this_thread::sleep_for(1s);
   // WHEN a calibration is started
   ASSERT_TRUE(rig.ask("start")["ok"].boolean());
-  const calibctl::JsonValue status = wait_for_end(rig, 60s);
+  const calibctl::JsonValue status = rig.wait_for_end(60s);
   // THEN it fails in preflight, saying the store cannot be written and why
   EXPECT_EQ(status["state"].string(), "failed");
   const std::string reason = status["reason"].string();
@@ -94,7 +83,7 @@ TEST(ReadOnlyStore, TurningReadOnlyMidRunKeepsTheFitAndCommitRetriesIt) {
   ASSERT_TRUE(wait_until([&] { return rig.ask("status")["waypoint"].integer() >= 2; }, 60s)) << daemon->log();
   // WHEN the history directory becomes read-only after preflight
   ASSERT_TRUE(remount(daemon->pid(), history, "ro"));
-  const calibctl::JsonValue status = wait_for_end(rig, 240s);
+  const calibctl::JsonValue status = rig.wait_for_end(240s);
   // THEN the run fails at its commit, and the fit and its samples are kept in pending/
   const std::string reason = status["reason"].string();
   std::printf("reason: %s\n", reason.c_str());

@@ -209,8 +209,7 @@ class SandboxRig {
            << "[load_cell]\nendpoint = \"" << robot->modbus_endpoint() << "\"\n"
            << "[pose]\nendpoint = \"" << robot->pose_endpoint() << "\"\n"
            << "[button]\nkind = \"none\"\n"
-           << "[limits]\nsettle_timeout_s = 15.0\npose_stale_ms = 3000\n"
-           << "[equilibrium]\nwindow_s = 1.0\nmax_speed = 0.03\nmax_angular_rate = 0.06\n";
+           << "[limits]\nsettle_timeout_s = 15.0\npose_stale_ms = 3000\n";
   }
 
   ~SandboxRig() {

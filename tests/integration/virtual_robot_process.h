@@ -1,9 +1,9 @@
 #pragma once
 // The virtual robot as its own process and a cdpr-calibd configuration for
 // it, for the tests that run real daemon processes (kill -9, a read-only
-// store in a mount namespace). The physics runs 20x faster than real time;
-// the daemon settings are the demo's equilibrium settings and, for the
-// small robot, its limits (the reference cable may dip below
+// store in a mount namespace, a hidden effect). The physics runs 20x faster
+// than real time; the daemon keeps its shipped equilibrium thresholds and,
+// for the small robot, gets its limits (the reference cable may dip below
 // the planner's 2 N while the small platform swings between waypoints).
 
 #include <chrono>
@@ -24,18 +24,20 @@ class VirtualRobotProcess {
  public:
   // `preset`: "small" or "large"; `waypoint_count` of the plan;
   // `extra_tables`: more TOML tables appended to the daemon's configuration
-  // (not [store] .. [equilibrium]).
+  // (not [store] .. [waypoints]); `robot_options`: more virtual-robot
+  // options (not --preset, --seed, --time-scale, --endpoints).
   explicit VirtualRobotProcess(const std::string& preset = "small", int waypoint_count = 35,
-                               const std::string& extra_tables = "") {
+                               const std::string& extra_tables = "",
+                               const std::vector<std::string>& robot_options = {}) {
     using namespace std::chrono_literals;
     char pattern[] = "/tmp/cdpr-robot-process-XXXXXX";
     dir = mkdtemp(pattern);
     socket = dir + "/control";
     state_dir = dir + "/state";
-    robot_ = std::make_unique<ChildProcess>(
-        std::vector<std::string>{built_program("tools/virtual-robot/virtual-robot"), "--preset", preset, "--seed",
-                                 "1", "--time-scale", "20", "--endpoints", dir + "/robot"},
-        dir + "/robot.log");
+    std::vector<std::string> robot_argv{built_program("tools/virtual-robot/virtual-robot"), "--preset", preset,
+                                        "--seed", "1", "--time-scale", "20", "--endpoints", dir + "/robot"};
+    robot_argv.insert(robot_argv.end(), robot_options.begin(), robot_options.end());
+    robot_ = std::make_unique<ChildProcess>(robot_argv, dir + "/robot.log");
     if (!wait_until([&] { return std::filesystem::exists(dir + "/robot/ready"); }, 60s)) {
       ADD_FAILURE() << "the virtual robot did not start: " << robot_->log();
     }
@@ -51,9 +53,7 @@ class VirtualRobotProcess {
                           << (small ? "min_tension = 2.0\nmax_tension = 300.0\nmargin = 1.5\nz_min = 3.0\n"
                                       "z_max = 18.0\n"
                                     : "")
-                          << "count = " << waypoint_count << "\n"
-                          << "[equilibrium]\nwindow_s = 1.0\nmax_speed = 0.03\nmax_angular_rate = 0.06\n"
-                          << extra_tables;
+                          << "count = " << waypoint_count << "\n" << extra_tables;
   }
   ~VirtualRobotProcess() {
     robot_->signal(SIGTERM);
@@ -76,6 +76,17 @@ class VirtualRobotProcess {
     return value ? *value : calibctl::JsonValue{};
   }
   bool answers() const { return ask("status")["ok"].boolean(); }
+  // The status once the run has ended (or the last one seen after `timeout`).
+  calibctl::JsonValue wait_for_end(std::chrono::seconds timeout) const {
+    calibctl::JsonValue status;
+    wait_until(
+        [&] {
+          status = ask("status");
+          return status["ok"].boolean() && !status["running"].boolean();
+        },
+        timeout);
+    return status;
+  }
 
   std::string dir, socket, state_dir, config;
 

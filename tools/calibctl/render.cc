@@ -46,6 +46,7 @@ std::string render_status(const JsonValue& s) {
     const std::string entry = run["entry"].string();
     out += format("  run: %s, %d samples, data in %s\n", run["outcome"].string().c_str(), run["samples"].integer(),
                   entry.empty() ? "(not kept)" : entry.c_str());
+    append_if(out, "model check", run["diagnosis"]);
   }
   return out;
 }

@@ -25,8 +25,12 @@ Sample measure(const TrueRobot& robot, const Equilibrium& state, double noise_sc
                           noise_scale * sigma.encoder_m * rng.normal();
   }
   const double tension = state.cables[robot.robot.reference_cable].tension_n;
-  sample.force_n = (1.0 + effects.force_gain) * tension + effects.force_bias_n + noise_scale * sigma.force_n * rng.normal();
+  sample.force_n = force_reading_n(effects, tension) + noise_scale * sigma.force_n * rng.normal();
   return sample;
+}
+
+double force_reading_n(const HiddenEffects& effects, double tension_n) {
+  return (1.0 + effects.force_gain) * tension_n + effects.force_bias_n;
 }
 
 }  // namespace cdpr::sim

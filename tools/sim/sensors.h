@@ -26,4 +26,9 @@ namespace cdpr::sim {
 
 Sample measure(const TrueRobot& robot, const Equilibrium& state, double noise_scale, Rng& rng, int sample_id);
 
+// The load cell's noiseless reading of a true tension [N]: (1 + gain) *
+// tension + bias, with the robot's hidden gain and bias. The virtual robot's
+// live load cell reads through this too.
+double force_reading_n(const HiddenEffects& effects, double tension_n);
+
 }  // namespace cdpr::sim

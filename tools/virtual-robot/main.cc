@@ -21,7 +21,7 @@ void on_signal(int) { g_stop.store(true); }
 int main(int argc, char** argv) {
   using cdpr::virtual_robot::VirtualRobotOptions;
   CLI::App app{"virtual-robot: a simulated cable robot (true heavy-cable equilibrium, first-order settling, "
-               "sensor noise of the preset) serving CANopen over a Unix socket, a Modbus TCP or RTU load cell and a "
+               "sensor noise of the preset, optional hidden effects) serving CANopen over a Unix socket, a Modbus TCP or RTU load cell and a "
                "pose stream; writes robot.toml (nominal), truth.toml and 'ready' into --endpoints"};
   app.set_version_flag("--version", cdpr::version::version_text("virtual-robot"));
   VirtualRobotOptions options;
@@ -62,6 +62,13 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--pose-rate", options.pose_rate_hz, "pose stream rate [Hz, real time]")
       ->check(CLI::Range(1.0, 1000.0))->capture_default_str();
+  app.add_option("--axial-stiffness", options.effects.axial_stiffness_n,
+                 "hidden elasticity: cable EA [N] (default inextensible); the encoders count unstretched cable")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--force-bias", options.effects.force_bias_n,
+                 "hidden load-cell bias b [N]: reading = (1 + g) * tension + b");
+  app.add_option("--force-gain", options.effects.force_gain, "hidden load-cell gain error g")
+      ->check(CLI::Range(-0.9, 10.0));
   CLI11_PARSE(app, argc, argv);
   options.preset = *cdpr::sim::parse_preset(preset);
   options.modbus_rtu = transport == "rtu";

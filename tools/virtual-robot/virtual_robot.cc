@@ -7,6 +7,7 @@
 
 #include "drivers/can/fd_can_transport.h"
 #include "drivers/pose/pose_line.h"
+#include "sim/sensors.h"
 #include "sim/stream_purpose.h"
 #include "virtual-robot/modbus_rtu_server.h"
 #include "virtual-robot/modbus_tcp_server.h"
@@ -39,6 +40,7 @@ sim::DatasetConfig dataset_config(const VirtualRobotOptions& options) {
   config.anchor_perturbation_m = options.anchor_perturbation_m;
   config.noise_scale = options.noise_scale;
   config.segments = options.physics.segments;
+  config.effects = options.effects;
   return config;
 }
 
@@ -158,7 +160,8 @@ void VirtualRobot::publish(hal::TimeUs now_us) {
   // Load cell: the cell calls its reading stable once it stops changing.
   const int reference = robot.reference_cable;
   const bool winches_still = nodes_->winches_still();
-  cell_->set_reading(physics_->tension_n(reference) + k * robot.noise.force_n * noise_.normal(),
+  cell_->set_reading(sim::force_reading_n(data_.true_robot.effects, physics_->tension_n(reference)) +
+                         k * robot.noise.force_n * noise_.normal(),
                      winches_still && physics_->tension_unsettled_n(reference) < std::max(1.0, robot.noise.force_n),
                      false);
   publish_pose(now_us);

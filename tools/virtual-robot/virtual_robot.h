@@ -16,8 +16,9 @@
 //   <dir>/ready       "modbus_endpoint = <endpoint>" and, on TCP,
 //                     "modbus_port = <port>", written once everything listens
 //
-// Physics (robot_physics.h) from the simulator's true equilibrium; sensor
-// noise per the preset (robot.toml [noise]) on every single reading.
+// Physics (robot_physics.h) from the simulator's true equilibrium, with the
+// options' hidden effects; sensor noise per the preset (robot.toml [noise])
+// on every single reading.
 // Time: simulated time runs time_scale times faster than the monotonic
 // clock (drive speeds, settling), while heartbeats, PDO and pose rates stay
 // in real time, as the daemon's timeouts are. Not thread-safe: one thread
@@ -57,6 +58,13 @@ struct VirtualRobotOptions {
   double pose_rate_hz = 100.0;
   PhysicsOptions physics;
   NodeLayout nodes;                   // encoder noise is set from the preset
+  // Hidden effects of the true robot (sim/true_robot.h), absent by default;
+  // robot.toml never describes them, truth.toml lists them under [effects].
+  // Elastic cables (axial_stiffness_n) stretch in the physics while the
+  // encoders count unstretched cable; the load cell reads (1 + force_gain) *
+  // tension + force_bias_n. Other effects change the physics the same way as
+  // in cdpr-sim.
+  sim::HiddenEffects effects;
 };
 
 // The simulated data set behind a virtual robot made with `options` (the

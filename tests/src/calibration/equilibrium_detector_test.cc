@@ -262,10 +262,11 @@ TEST(EquilibriumDetector, ShippedThresholdsSeeMotionAtAnyTimeScale) {
 }
 
 TEST(EquilibriumDetector, WindowHoldsMinSamplesWhenPosesAreSparseInSourceTime) {
-  // GIVEN observations 0.4 s apart in source time and a 2 s window of 20 samples
+  // GIVEN observations 0.4 s apart in source time (the daemon's 50 Hz loop
+  // on a source 20x faster) and the shipped 2 s window of min_samples
   const EquilibriumThresholds shipped;
   EquilibriumDetector detector(shipped, 1024);
-  for (int k = 0; k < 40; ++k) {
+  for (int k = 0; k < 2 * shipped.min_samples; ++k) {
     EquilibriumObservation o;
     o.time_us = k * 400'000;
     o.tension_n = 500.0;

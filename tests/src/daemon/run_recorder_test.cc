@@ -34,8 +34,10 @@ std::string joined(const std::vector<std::string>& lines) {
 class RecordedRig {
  public:
   explicit RecordedRig(std::uintmax_t budget_bytes = 1'000'000'000,
+                       std::optional<DiagnosisOptions> model_check = std::nullopt,
                        std::optional<CalibrationOptions> report_fit = std::nullopt)
-      : recorder(std::make_unique<RunRecorder>(rig.store.state_dir(), budget_bytes, std::nullopt, report_fit)) {
+      : recorder(std::make_unique<RunRecorder>(rig.store.state_dir(), budget_bytes, std::move(model_check),
+                                               report_fit)) {
     for (std::string& message : recorder->recover("2026-11-23T08:00:00Z", "died")) messages.push_back(message);
   }
   bool run_until(const std::function<bool()>& done) {
@@ -100,11 +102,25 @@ TEST(RunRecorder, ACommittedRunKeepsItsSamplesRobotLogAndFit) {
   };
   const std::string samples_text = std::to_string(r.rig.status().samples);
   EXPECT_TRUE(contains(ask("status"), "\"run\":{\"entry\":\"" + entry + "\",\"outcome\":\"committed\",\"samples\":" +
-                                          samples_text + "}"))
+                                          samples_text + ",\"diagnosis\":\"\"}"))
       << ask("status");
   EXPECT_TRUE(contains(ask("show"), "\"run\":{\"entry\":\"" + entry + "\",\"outcome\":\"committed\",\"samples\":" +
                                         samples_text + ",\"skipped\":0,"))
       << ask("show");
+}
+
+TEST(RunRecorder, TheModelCheckOfARunReachesItsStatus) {
+  // GIVEN the recorder with the model check on WHEN a calibration runs to its end
+  RecordedRig r(1'000'000'000, DiagnosisOptions{});
+  ASSERT_TRUE(r.run_to_end());
+  EXPECT_EQ(r.rig.status().run_diagnosis, "");  // picked up by the next step after the check
+  // THEN after the check, the next step puts the verdict of run.toml into the status
+  ASSERT_TRUE(r.run_until([] { return true; }));
+  const std::string verdict = r.log(1).diagnosis;
+  EXPECT_FALSE(verdict.empty());
+  EXPECT_EQ(r.rig.status().run_diagnosis, verdict);
+  const std::string status = control::respond("status", *r.rig.machine, r.rig.store, r.rig.clock.now_us());
+  EXPECT_TRUE(contains(status, ",\"diagnosis\":\"" + verdict.substr(0, 20))) << status;
 }
 
 TEST(RunRecorder, AnAbortedRunKeepsWhatItMeasured) {
@@ -148,7 +164,7 @@ TEST(RunRecorder, ARunTheDaemonDidNotFinishIsFoundInterruptedAtTheNextStart) {
 
 TEST(RunRecorder, ACommittedRunGetsItsReportBesideTheFit) {
   // GIVEN the recorder as the daemon makes it (the solver's options for the report's residuals)
-  RecordedRig r(1'000'000'000, CalibrationOptions{});
+  RecordedRig r(1'000'000'000, std::nullopt, CalibrationOptions{});
   // WHEN a calibration runs to its commit
   ASSERT_TRUE(r.run_to_end());
   ASSERT_EQ(r.rig.status().state, CalibrationState::kDone) << r.rig.status().reason;
