@@ -30,12 +30,6 @@ DesignInformation covariance(const DesignInformation& information) {
 
 double variance_sum(const DesignInformation& information) { return covariance(information).trace(); }
 
-DesignInformation total_information(const Robot& robot, const std::vector<Pose>& poses) {
-  DesignInformation total = ridge(robot);
-  for (const Pose& pose : poses) total += pose_information(robot, pose);
-  return total;
-}
-
 }  // namespace
 
 DesignInformation pose_information(const Robot& robot, const Pose& pose) {
@@ -73,6 +67,12 @@ DesignInformation pose_information(const Robot& robot, const Pose& pose) {
   return i_parameters - i_cross.transpose() * i_pose.llt().solve(i_cross);
 }
 
+DesignInformation design_information(const Robot& robot, const std::vector<Pose>& poses) {
+  DesignInformation total = ridge(robot);
+  for (const Pose& pose : poses) total += pose_information(robot, pose);
+  return total;
+}
+
 std::vector<int> choose_informative_poses(const Robot& robot, const std::vector<Pose>& candidates, int count) {
   std::vector<DesignInformation> information;
   information.reserve(candidates.size());
@@ -101,11 +101,11 @@ std::vector<int> choose_informative_poses(const Robot& robot, const std::vector<
 }
 
 double design_variance_sum(const Robot& robot, const std::vector<Pose>& poses) {
-  return variance_sum(total_information(robot, poses));
+  return variance_sum(design_information(robot, poses));
 }
 
 DesignInformation design_covariance(const Robot& robot, const std::vector<Pose>& poses) {
-  return covariance(total_information(robot, poses));
+  return covariance(design_information(robot, poses));
 }
 
 }  // namespace cdpr

@@ -32,6 +32,10 @@ using DesignInformation = Eigen::Matrix<double, kDesignParameters, kDesignParame
 // Information one measured pose adds about anchors and offsets (pose eliminated).
 DesignInformation pose_information(const Robot& robot, const Pose& pose);
 
+// Information about anchors and offsets of a set of poses, plus the tiny
+// ridge below (so its inverse is always defined).
+DesignInformation design_information(const Robot& robot, const std::vector<Pose>& poses);
+
 // Indices of `count` distinct candidates, in the order chosen: each the one
 // that lowers the summed variance most. Fewer when there are fewer
 // candidates. A tiny ridge keeps the first, rank-deficient steps defined.

@@ -6,6 +6,7 @@
 
 #include "solver/calibration/pose_design.h"
 #include "src/calibration/message_text.h"
+#include "src/calibration/waypoint_tour.h"
 
 namespace cdpr::calibration {
 namespace {
@@ -80,9 +81,9 @@ std::vector<Eigen::Vector3d> jittered_grid(const Box& box, const PlannerOptions&
   return points;
 }
 
-// Farthest-point selection: start nearest `centre`, then repeatedly the
-// candidate farthest from everything chosen so far.
-std::vector<int> farthest_points(const std::vector<Waypoint>& candidates, const Eigen::Vector3d& centre, int count) {
+}  // namespace
+
+std::vector<int> spread_waypoints(const std::vector<Waypoint>& candidates, const Eigen::Vector3d& centre, int count) {
   std::vector<int> chosen;
   std::vector<double> distance(candidates.size(), std::numeric_limits<double>::infinity());
   int next = 0;
@@ -103,6 +104,8 @@ std::vector<int> farthest_points(const std::vector<Waypoint>& candidates, const 
   return chosen;
 }
 
+namespace {
+
 // A-optimal selection on the robot's nominal geometry.
 std::vector<int> informative_points(const Robot& robot, const std::vector<Waypoint>& candidates, int count) {
   std::vector<Pose> poses;
@@ -111,17 +114,15 @@ std::vector<int> informative_points(const Robot& robot, const std::vector<Waypoi
   return choose_informative_poses(robot, poses, count);
 }
 
-// Greedy nearest-neighbour tour from `start`: short moves between poses.
-std::vector<Waypoint> travel_order(std::vector<Waypoint> waypoints, const Eigen::Vector3d& start) {
+// A short tour from `start` (waypoint_tour.h) on the nominal anchors.
+std::vector<Waypoint> travel_order(const Robot& robot, std::vector<Waypoint> waypoints, const Eigen::Vector3d& start) {
+  std::vector<Pose> stops;
+  stops.reserve(waypoints.size());
+  for (const Waypoint& w : waypoints) stops.push_back(w.rest.world_T_platform);
   std::vector<Waypoint> ordered;
-  Eigen::Vector3d at = start;
-  while (!waypoints.empty()) {
-    auto nearest = std::min_element(waypoints.begin(), waypoints.end(), [&](const Waypoint& a, const Waypoint& b) {
-      return (a.rest.world_T_platform.position_world - at).norm() < (b.rest.world_T_platform.position_world - at).norm();
-    });
-    at = nearest->rest.world_T_platform.position_world;
-    ordered.push_back(std::move(*nearest));
-    waypoints.erase(nearest);
+  ordered.reserve(waypoints.size());
+  for (const int k : tour_order(robot, nominal_anchors(robot), Pose{start, Eigen::Quaterniond::Identity()}, stops)) {
+    ordered.push_back(std::move(waypoints[k]));
   }
   return ordered;
 }
@@ -143,16 +144,13 @@ std::string check_planner_options(const Robot& robot, const PlannerOptions& opti
   return {};
 }
 
-WaypointPlan plan_waypoints(const Robot& robot, const std::array<double, kCableCount>& payout_offset_m,
-                            const Eigen::Vector3d& start_world, const PlannerOptions& options) {
+WaypointPlan candidate_waypoints(const Robot& robot, const std::array<double, kCableCount>& payout_offset_m,
+                                 const PlannerOptions& options) {
   WaypointPlan plan;
   plan.problem = check_planner_options(robot, options);
   if (!plan.ok()) return plan;
-  const Box box = workspace_box(robot, options);
   const auto anchors = nominal_anchors(robot);
-
-  std::vector<Waypoint> feasible;
-  for (const Eigen::Vector3d& position : jittered_grid(box, options)) {
+  for (const Eigen::Vector3d& position : jittered_grid(workspace_box(robot, options), options)) {
     std::string no_rest;
     auto rest = solve_static_pose(robot, anchors, position, &no_rest);
     if (!rest) {
@@ -165,20 +163,30 @@ WaypointPlan plan_waypoints(const Robot& robot, const std::array<double, kCableC
       plan.rejected.push_back({position, std::move(why)});
       continue;
     }
-    feasible.push_back(std::move(waypoint));
+    plan.waypoints.push_back(std::move(waypoint));
   }
+  return plan;
+}
+
+WaypointPlan plan_waypoints(const Robot& robot, const std::array<double, kCableCount>& payout_offset_m,
+                            const Eigen::Vector3d& start_world, const PlannerOptions& options) {
+  WaypointPlan plan = candidate_waypoints(robot, payout_offset_m, options);
+  if (!plan.ok()) return plan;
+  std::vector<Waypoint> feasible = std::move(plan.waypoints);
+  plan.waypoints.clear();
   if (static_cast<int>(feasible.size()) < options.waypoint_count) {
     plan.problem = "only " + std::to_string(feasible.size()) + " of " + std::to_string(options.waypoint_count) +
                    " waypoints feasible within the limits (" + std::to_string(plan.rejected.size()) + " rejected)";
     return plan;
   }
+  const Box box = workspace_box(robot, options);
   std::vector<Waypoint> chosen;
   for (const int k : options.selection == WaypointSelection::kInformative
                          ? informative_points(robot, feasible, options.waypoint_count)
-                         : farthest_points(feasible, 0.5 * (box.low + box.high), options.waypoint_count)) {
+                         : spread_waypoints(feasible, 0.5 * (box.low + box.high), options.waypoint_count)) {
     chosen.push_back(feasible[k]);
   }
-  plan.waypoints = travel_order(std::move(chosen), start_world);
+  plan.waypoints = travel_order(robot, std::move(chosen), start_world);
   return plan;
 }
 

@@ -16,8 +16,8 @@
 // not where a controller would put the robot, the true robot cannot be led
 // there by paying out, and a small anchor error moves it far. From the
 // feasible ones, `waypoint_count` are picked (WaypointSelection), then
-// ordered greedily by travel from the start position. Rejected candidates
-// are returned with the reason.
+// ordered as a short tour from the start position (waypoint_tour.h).
+// Rejected candidates are returned with the reason.
 //
 // Payout target of cable i = arc length (Eq. 4) + payout_offset_m[i], the
 // encoder offset: from the previous calibration, or estimated at the start
@@ -85,6 +85,16 @@ struct WaypointPlan {
 
 // Checks the options (counts, band, margin leaving a box); empty when fine.
 std::string check_planner_options(const Robot& robot, const PlannerOptions& options);
+
+// Every feasible candidate (in `waypoints`, grid order) and every rejected
+// one with its reason; `problem` only for bad options. For strategies that
+// pick among the candidates as they go (sequential_planner.h).
+WaypointPlan candidate_waypoints(const Robot& robot, const std::array<double, kCableCount>& payout_offset_m,
+                                 const PlannerOptions& options);
+
+// Farthest-point order over `candidates` (WaypointSelection::kSpread): the
+// one nearest `centre` first. count <= candidates.size().
+std::vector<int> spread_waypoints(const std::vector<Waypoint>& candidates, const Eigen::Vector3d& centre, int count);
 
 WaypointPlan plan_waypoints(const Robot& robot, const std::array<double, kCableCount>& payout_offset_m,
                             const Eigen::Vector3d& start_world, const PlannerOptions& options);

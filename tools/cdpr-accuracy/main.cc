@@ -6,12 +6,56 @@
 
 #include "cdpr-accuracy/accuracy.h"
 #include "cdpr-accuracy/model_check.h"
+#include "cdpr-accuracy/replay.h"
 #include "version/version.h"
 
 namespace {
 
 void print_row(const char* what, const cdpr::accuracy::Distribution& d) {
   std::printf("  %-22s mean %8.4f  median %8.4f  p90 %8.4f  worst %8.4f\n", what, d.mean, d.median, d.p90, d.worst);
+}
+
+// --strategy: replays a waypoint strategy per seed and prints its table row.
+int run_replay(const cdpr::accuracy::ReplayCase& c, const std::string& preset_name, const std::string& strategy,
+               int seeds, int first_seed, bool verbose) {
+  std::vector<cdpr::accuracy::ReplayResult> runs;
+  for (int s = 0; s < seeds; ++s) {
+    runs.push_back(cdpr::accuracy::replay(c, static_cast<std::uint64_t>(first_seed + s)));
+    const auto& r = runs.back();
+    if (verbose) {
+      std::printf("seed %3llu %s time %6.1f min waypoints %2d skipped %d travel %7.1f m (nearest neighbour alone "
+                  "%7.1f m) anchor mean %.4f worst %.4f m offset %.4f m largest sigma anchor %.4f offset %.4f m%s%s "
+                  "%s\n",
+                  static_cast<unsigned long long>(r.seed), r.ok ? "ok    " : "FAILED", r.robot_time_s / 60.0,
+                  r.waypoints, r.skipped, r.travel_m, r.travel_nn_m, r.anchor_error_m, r.worst_anchor_error_m,
+                  r.offset_error_m, r.largest_anchor_sigma_m, r.largest_offset_sigma_m, r.stop.empty() ? "" : " stop: ",
+                  r.stop.c_str(), r.ok ? "" : r.message.c_str());
+    } else {
+      std::fprintf(stderr, "\r%s: run %d/%d", strategy.c_str(), s + 1, seeds);
+    }
+  }
+  if (!verbose) std::fprintf(stderr, "\n");
+  double time_s = 0.0, waypoints = 0.0, anchor = 0.0, worst = 0.0, offset = 0.0, sq = 0.0, travel = 0.0, nn = 0.0;
+  int count = 0, failures = 0;
+  for (const auto& r : runs) {
+    const double n = static_cast<double>(runs.size());
+    time_s += r.robot_time_s / n;
+    waypoints += r.waypoints / n;
+    travel += r.travel_m / n;
+    nn += r.travel_nn_m / n;
+    anchor += r.anchor_error_m / n;
+    worst = std::max(worst, r.worst_anchor_error_m);
+    offset += r.offset_error_m / n;
+    sq += r.normalised_sq_sum;
+    count += r.normalised_count;
+    failures += !r.ok;
+  }
+  std::printf("| %s, %.1f m off | %s | %.1f | %.1f | %.4f / %.4f | %.4f | %.2f |  (%d runs, %d failed; mean travel "
+              "%.0f m%s)\n",
+              preset_name.c_str(), c.anchor_perturbation_m, strategy.c_str(), time_s / 60.0, waypoints, anchor, worst,
+              offset, count ? std::sqrt(sq / count) : 0.0, static_cast<int>(runs.size()), failures, travel,
+              nn > 0.0 ? (", nearest neighbour alone " + std::to_string(static_cast<int>(nn + 0.5)) + " m").c_str() : "");
+  return failures ? 1 : 0;
 }
 
 }  // namespace
@@ -62,6 +106,30 @@ int main(int argc, char** argv) {
   app.add_flag("--truth-start", truth_start,
                "also fit each data set from the true anchors and count fits whose final cost differs by more than "
                "1e-6 relative (a different minimum) or that fail");
+  std::string strategy;
+  cdpr::accuracy::ReplayCase replay_case;
+  app.add_option("--strategy", strategy,
+                 "replay a waypoint strategy of the daemon (spread and informative: --poses waypoints as a tour; "
+                 "sequential: until the targets) and print robot time, waypoints and errors")
+      ->check(CLI::IsMember({"spread", "informative", "sequential"}));
+  app.add_option("--target-anchor-sigma", replay_case.sequential.target_anchor_sigma_m,
+                 "sequential: stop when every anchor axis sigma is at most this [m]")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--target-offset-sigma", replay_case.sequential.target_offset_sigma_m,
+                 "sequential: and every offset sigma at most this [m]")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--min-count", replay_case.sequential.min_count, "sequential: waypoints at least")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--max-count", replay_case.sequential.max_count, "sequential: waypoints at most")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--winch-speed", replay_case.sequential.winch_speed_mps, "robot-time model: winch profile speed [m/s]")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--settle", replay_case.sequential.settle_s,
+                 "robot-time model: wait for rest plus the rest window, per waypoint [s]")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--row-noise-scale", replay_case.noise_scale,
+                 "replay: a sample row's noise as a fraction of one reading's (the daemon averages a rest window)")
+      ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_flag("--model-check", model_check_only, "only run the Table I model check");
   app.add_flag("-v,--verbose", verbose, "one line per run");
   CLI11_PARSE(app, argc, argv);
@@ -79,6 +147,16 @@ int main(int argc, char** argv) {
     std::printf("  lengths [%.1f, %.1f] m  forces [%.1f, %.1f] N\n", c.min_length_m, c.max_length_m, c.min_force_n,
                 c.max_force_n);
     return 0;
+  }
+
+  if (!strategy.empty()) {
+    replay_case.preset = preset;
+    replay_case.strategy = strategy == "spread"        ? cdpr::accuracy::Strategy::kSpread
+                           : strategy == "informative" ? cdpr::accuracy::Strategy::kInformative
+                                                       : cdpr::accuracy::Strategy::kSequential;
+    replay_case.count = poses;
+    replay_case.anchor_perturbation_m = perturbation >= 0 ? perturbation : 0.3;
+    return run_replay(replay_case, preset_name, strategy, seeds, first_seed, verbose);
   }
 
   cdpr::accuracy::Case c;

@@ -1,0 +1,117 @@
+#pragma once
+// Sequential, information-driven waypoints: measure until the anchors and
+// encoder offsets are known to a stated accuracy, in as little robot time as
+// the candidates allow (docs/calibration.md "Sequential waypoints").
+//
+// 1. Start with the fewest spread waypoints (farthest-point order over the
+//    feasible candidates) whose straight-cable Fisher information on the
+//    nominal anchors has full rank: the problem is identifiable. At least
+//    `min_count` of them when the caller needs that many rows anyway.
+// 2. After each sample, re-solve (calibrate() on every row so far, started
+//    from the last estimate) and take its covariance of anchors and offsets.
+// 3. Stop when every anchor axis sigma <= target_anchor_sigma_m and every
+//    offset sigma <= target_offset_sigma_m (kTargetReached), at max_count
+//    samples (kMaxCount), or when no candidate is left (kNoCandidates).
+// 4. Otherwise go to the candidate with the largest expected gain per second
+//    of robot time. Gain: the posterior variance above the targets that the
+//    pose would remove, each variance in units of its target squared,
+//        sum_j [P_jj - t_j^2]+ - [S_jj - t_j^2]+,   S = (P^-1 + I_k)^-1,
+//    P the fit's covariance, I_k the pose's information at the current
+//    estimate (solver/calibration/pose_design.h) scaled to the rows' own
+//    encoder noise; variance already below its target is worth nothing more.
+//    Time: travel from the current waypoint at the winch speed
+//    (waypoint_tour.h) plus the expected settle time.
+//
+// The candidates' gains are scored with fixed-size matrices: no allocation
+// in the per-candidate loop. Pure logic: no I/O, no clock.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "solver/calibration/calibrate.h"
+#include "solver/calibration/pose_design.h"
+#include "src/calibration/waypoint_planner.h"
+#include "src/calibration/waypoint_tour.h"
+
+namespace cdpr::calibration {
+
+struct SequentialOptions {
+  double target_anchor_sigma_m = 0.02;  // every anchor axis 1-sigma [m]
+  // Every encoder offset 1-sigma [m]. An offset error moves the modelled
+  // platform along its cable by as much, like an anchor error along the
+  // cable: the same budget as an anchor axis.
+  double target_offset_sigma_m = 0.02;
+  int min_count = 0;                    // samples before stopping, at least
+  int max_count = 35;                   // samples, at most
+  double winch_speed_mps = 2.0;         // profile speed of the winches [m/s]
+  double settle_s = 10.0;               // expected wait for rest plus the window, per waypoint [s]
+  CalibrationOptions solver;            // of each re-solve
+};
+
+enum class StopReason { kNotStopped, kTargetReached, kMaxCount, kNoCandidates };
+const char* to_string(StopReason reason);
+
+// Where the sequential run stands, for status displays.
+struct SequentialStatus {
+  int samples = 0;
+  bool solved = false;                  // the last re-solve succeeded
+  double largest_anchor_sigma_m = 0.0;  // of the last successful re-solve
+  double largest_offset_sigma_m = 0.0;
+  // Largest sigma over its target (anchor axes and offsets); <= 1 reached.
+  double largest_sigma_ratio = 0.0;
+  // Samples still needed if sigmas shrink as 1 / sqrt(samples) from here,
+  // and the robot time [s] they take at the mean time per waypoint modelled so far.
+  int estimated_samples_left = 0;
+  double estimated_time_left_s = 0.0;
+  StopReason stop = StopReason::kNotStopped;
+};
+
+class SequentialPlanner {
+ public:
+  // `candidates`: feasible waypoints (candidate_waypoints()); `start`: where
+  // the platform is. The nominal robot's noise weighs the information.
+  SequentialPlanner(const Robot& nominal, std::vector<Waypoint> candidates, const Pose& start,
+                    const SequentialOptions& options);
+
+  // Index into candidates() of the waypoint to measure next; empty when the
+  // run is over (status().stop says why). The same answer until
+  // add_sample() or skip() moves on.
+  std::optional<int> next();
+  // The sample measured at candidate `index` (re-solves once the initial
+  // waypoints are done).
+  void add_sample(int index, const Sample& sample);
+  // Candidate `index` could not be measured (not reached, no rest): never offered again.
+  void skip(int index);
+
+  const std::vector<Waypoint>& candidates() const { return candidates_; }
+  const std::vector<Sample>& samples() const { return samples_; }
+  const std::vector<int>& initial() const { return initial_; }
+  // The last successful re-solve (ok() false before the first).
+  const CalibrationResult& last_fit() const { return fit_; }
+  SequentialStatus status() const { return status_; }
+  // Modelled robot time [s] of the moves and settles so far.
+  double modelled_time_s() const { return modelled_time_s_; }
+
+ private:
+  void resolve();
+  void decide();
+  std::optional<int> best_candidate() const;
+  double move_time_s(int index) const;
+
+  Robot nominal_;
+  std::vector<Waypoint> candidates_;
+  SequentialOptions options_;
+  std::vector<int> initial_;     // the identifiable spread set, in tour order
+  std::size_t initial_done_ = 0;
+  std::vector<bool> used_;       // measured or skipped
+  std::vector<Sample> samples_;
+  Pose at_;                      // the platform's (planned) pose now
+  CalibrationResult fit_;
+  Robot estimate_;               // nominal with the last fit's anchors: the warm start
+  std::optional<int> next_;
+  double modelled_time_s_ = 0.0;
+  SequentialStatus status_;
+};
+
+}  // namespace cdpr::calibration

@@ -1,0 +1,167 @@
+#include "cdpr-accuracy/replay.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "sim/dataset.h"
+#include "sim/equilibrium.h"
+#include "sim/rng.h"
+#include "sim/sensors.h"
+#include "sim/stream_purpose.h"
+#include "src/calibration/waypoint_tour.h"
+
+namespace cdpr::accuracy {
+namespace {
+
+using calibration::Waypoint;
+
+// The true robot led to waypoint `index`, its robot time and its sample.
+class Rig {
+ public:
+  Rig(const sim::SimulatedDataset& data, const ReplayCase& c, std::uint64_t seed, const Pose& start)
+      : data_(data), case_(c), seed_(seed), at_(start) {}
+
+  // Moves to `waypoint` and measures; empty when the true robot has no rest there.
+  std::optional<Sample> visit(int index, const Waypoint& waypoint) {
+    const Pose& planned = waypoint.rest.world_T_platform;
+    const Eigen::Matrix3d rotation = planned.world_R_platform.toRotationMatrix();
+    const double yaw_rad = std::atan2(rotation(1, 0), rotation(0, 0));
+    const sim::EquilibriumResult state = sim::solve_equilibrium(data_.true_robot, planned.position_world, yaw_rad);
+    const Pose& reached = state ? state->world_T_platform : planned;
+    const double travel_m =
+        calibration::winch_travel_m(data_.true_robot.robot, nominal_anchors(data_.true_robot.robot), at_, reached);
+    travel_m_ += travel_m;
+    robot_time_s_ += travel_m / case_.sequential.winch_speed_mps + case_.sequential.settle_s;
+    at_ = reached;
+    if (!state) return std::nullopt;
+    sim::Rng noise = sim::Rng::stream(seed_, sim::kStreamSensorNoise, static_cast<std::uint64_t>(index));
+    return sim::measure(data_.true_robot, *state, case_.noise_scale, noise, sample_id_++);
+  }
+
+  double robot_time_s() const { return robot_time_s_; }
+  double travel_m() const { return travel_m_; }
+
+ private:
+  const sim::SimulatedDataset& data_;
+  const ReplayCase& case_;
+  std::uint64_t seed_;
+  Pose at_;
+  int sample_id_ = 0;
+  double robot_time_s_ = 0.0;
+  double travel_m_ = 0.0;
+};
+
+void score(const sim::SimulatedDataset& data, const CalibrationResult& fit, ReplayResult& r) {
+  r.ok = fit.ok;
+  r.message = fit.message;
+  if (!fit.ok) return;
+  const int n = kCableCount;
+  for (int i = 0; i < n; ++i) {
+    const WinchCalibration& w = fit.calibration.winches[i];
+    const WinchTruth& truth = data.truth.winches[i];
+    const Eigen::Vector3d error = w.anchor_world - truth.anchor_world;
+    const double offset_error = w.offset_m - truth.offset_m;
+    r.anchor_error_m += error.norm() / n;
+    r.worst_anchor_error_m = std::max(r.worst_anchor_error_m, error.norm());
+    r.offset_error_m += std::abs(offset_error) / n;
+    r.largest_anchor_sigma_m = std::max(r.largest_anchor_sigma_m, w.anchor_sigma.maxCoeff());
+    r.largest_offset_sigma_m = std::max(r.largest_offset_sigma_m, w.offset_sigma_m);
+    r.normalised_sq_sum += error.cwiseQuotient(w.anchor_sigma).squaredNorm() + std::pow(offset_error / w.offset_sigma_m, 2);
+    r.normalised_count += 4;
+  }
+}
+
+}  // namespace
+
+calibration::PlannerOptions replay_planner_options(sim::Preset preset) {
+  calibration::PlannerOptions o;  // the daemon's [waypoints] defaults (docs/configuration.md)
+  o.margin_m = 20.0;
+  o.z_min_m = 5.0;
+  o.z_max_m = 35.0;
+  o.max_tension_n = 3000.0;
+  if (preset == sim::Preset::kSmall) {
+    // 12.5 x 4.5 m footprint, anchors 28.5 m up, a 4.4 kg platform.
+    o.margin_m = 1.0;
+    o.z_min_m = 3.0;
+    o.z_max_m = 18.0;
+    o.min_tension_n = 2.0;
+  }
+  return o;
+}
+
+ReplayResult replay(const ReplayCase& c, std::uint64_t seed) {
+  ReplayResult r;
+  r.seed = seed;
+  sim::DatasetConfig config;
+  config.preset = c.preset;
+  config.pose_count = 1;  // for the robots and the truth; the samples are measured here
+  config.seed = seed;
+  config.anchor_perturbation_m = c.anchor_perturbation_m;
+  config.noise_scale = c.noise_scale;
+  const auto data = sim::simulate_dataset(config);
+  if (!data) {
+    r.message = "simulation failed: " + data.error();
+    return r;
+  }
+  const Robot& nominal = data->nominal;
+  calibration::PlannerOptions options = replay_planner_options(c.preset);
+  options.waypoint_count = c.count;
+  options.seed = static_cast<std::uint32_t>(seed);
+  const std::array<double, kCableCount> no_offsets{};
+  calibration::WaypointPlan candidates = calibration::candidate_waypoints(nominal, no_offsets, options);
+  if (!candidates.ok() || candidates.waypoints.empty()) {
+    r.message = "no candidates: " + candidates.problem;
+    return r;
+  }
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const Waypoint& w : candidates.waypoints) centre += w.rest.world_T_platform.position_world;
+  centre /= static_cast<double>(candidates.waypoints.size());
+  const Pose start{Eigen::Vector3d(centre.x(), centre.y(), options.z_min_m), Eigen::Quaterniond::Identity()};
+
+  Rig rig(*data, c, seed, start);
+  std::vector<Sample> samples;
+  if (c.strategy == Strategy::kSequential) {
+    calibration::SequentialOptions sequential = c.sequential;
+    sequential.solver = CalibrationOptions{};
+    calibration::SequentialPlanner planner(nominal, std::move(candidates.waypoints), start, sequential);
+    while (const std::optional<int> k = planner.next()) {
+      if (std::optional<Sample> sample = rig.visit(*k, planner.candidates()[*k])) {
+        planner.add_sample(*k, *sample);
+      } else {
+        ++r.skipped;
+        planner.skip(*k);
+      }
+    }
+    samples = planner.samples();
+    r.stop = calibration::to_string(planner.status().stop);
+  } else {
+    options.selection = c.strategy == Strategy::kInformative ? calibration::WaypointSelection::kInformative
+                                                             : calibration::WaypointSelection::kSpread;
+    const calibration::WaypointPlan plan = calibration::plan_waypoints(nominal, no_offsets, start.position_world, options);
+    if (!plan.ok()) {
+      r.message = "no plan: " + plan.problem;
+      return r;
+    }
+    std::vector<Pose> stops;
+    for (const Waypoint& w : plan.waypoints) stops.push_back(w.rest.world_T_platform);
+    const auto anchors = nominal_anchors(nominal);
+    r.travel_nn_m = calibration::tour_travel_m(nominal, anchors, start, stops,
+                                               calibration::tour_order(nominal, anchors, start, stops, false));
+    for (std::size_t k = 0; k < plan.waypoints.size(); ++k) {
+      // Noise stream by plan position: each plan's own draws.
+      if (std::optional<Sample> sample = rig.visit(static_cast<int>(k), plan.waypoints[k])) {
+        samples.push_back(*sample);
+      } else {
+        ++r.skipped;
+      }
+    }
+  }
+  r.robot_time_s = rig.robot_time_s();
+  r.travel_m = rig.travel_m();
+  r.waypoints = static_cast<int>(samples.size());
+  score(*data, calibrate(nominal, samples, CalibrationOptions{}), r);
+  return r;
+}
+
+}  // namespace cdpr::accuracy

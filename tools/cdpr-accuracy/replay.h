@@ -1,0 +1,65 @@
+#pragma once
+// Replays a waypoint strategy of the daemon offline on the simulator
+// (docs/calibration.md "Sequential waypoints"): the platform is led to each
+// planned waypoint (the true robot's rest pose at the planned position and
+// heading), measured there, and the run is scored by its robot time and the
+// final fit's accuracy.
+//
+// Robot-time model, per waypoint: the move, max_i |payout_i(to) -
+// payout_i(from)| / winch speed (the winches run coordinated, the farthest
+// at the profile speed; acceleration ignored), from the previous waypoint
+// (the first from the start pose), plus `settle_s`: the wait for rest and
+// the rest window, taken as the same for every waypoint. The solve time is
+// not robot time. A waypoint where the true robot has no taut rest is
+// skipped after its move and settle time.
+//
+// A sample is one reading of every sensor at the true rest with the
+// preset's noise times `noise_scale`: the daemon averages a rest window into
+// a row whose noise is a fraction of one reading's (docs/calibration.md
+// "Honest sigmas"), and robot.toml's [noise] says so, as the daemon's rows'
+// own sigmas do.
+
+#include <cstdint>
+#include <string>
+
+#include "sim/presets.h"
+#include "src/calibration/sequential_planner.h"
+#include "src/calibration/waypoint_planner.h"
+
+namespace cdpr::accuracy {
+
+enum class Strategy { kSpread, kInformative, kSequential };
+
+struct ReplayCase {
+  sim::Preset preset = sim::Preset::kLarge;
+  Strategy strategy = Strategy::kSequential;
+  int count = 35;                       // waypoints of the fixed plans
+  double anchor_perturbation_m = 0.3;   // nominal anchors off the truth by this [m]
+  double noise_scale = 0.2;
+  calibration::SequentialOptions sequential;  // also the robot-time model (winch speed, settle)
+};
+
+struct ReplayResult {
+  std::uint64_t seed = 0;
+  bool ok = false;              // the final fit succeeded
+  std::string message;
+  double robot_time_s = 0.0;
+  double travel_m = 0.0;        // summed winch travel
+  double travel_nn_m = 0.0;     // fixed plans: the same waypoints by nearest neighbour alone
+  int waypoints = 0;            // measured
+  int skipped = 0;
+  std::string stop;             // sequential: why it stopped
+  double anchor_error_m = 0.0;        // mean over cables of |a - a_true|
+  double worst_anchor_error_m = 0.0;  // largest over cables
+  double offset_error_m = 0.0;        // mean over cables of |l0 - l0_true|
+  double largest_anchor_sigma_m = 0.0, largest_offset_sigma_m = 0.0;  // final fit
+  double normalised_sq_sum = 0.0;     // (error / sigma)^2 over anchor axes and offsets
+  int normalised_count = 0;
+};
+
+// The daemon's planner settings for the preset's robot (waypoint box, limits).
+calibration::PlannerOptions replay_planner_options(sim::Preset preset);
+
+ReplayResult replay(const ReplayCase& c, std::uint64_t seed);
+
+}  // namespace cdpr::accuracy
