@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include "solver/model/cable_prediction.h"
 #include "solver/calibration/effect_pose_factor.h"
@@ -419,6 +420,8 @@ CalibrationResult refit_without(const Robot& robot, const std::vector<Sample>& s
     if (!refit.ok || predicted == refit.left_out_residuals.end() ||
         std::abs(predicted->value) > options.rejection_threshold_sigma * misfit_scale) {
       confirmed.push_back(r);
+      // A candidate from a left-out row has no robust residual: the refit's prediction names its size.
+      if (std::isnan(r.value) && predicted != refit.left_out_residuals.end()) confirmed.back().value = predicted->value;
     }
   }
   if (confirmed.size() < robust.gross_errors.size()) {
@@ -432,6 +435,46 @@ CalibrationResult refit_without(const Robot& robot, const std::vector<Sample>& s
     refit.message += "; " + std::to_string(confirmed.size()) + " readings with gross errors left out";
   }
   return refit;
+}
+
+// When the robust fit flags more rows than allowed on a small set, one
+// high-leverage gross error may have pulled the fit into a basin where good
+// rows look bad. Each row is left out in turn and the robust fit redone; the
+// hypothesis that flags the fewest rows wins. Its flagged readings and every
+// reading of the row it left out become the candidates to leave out: the
+// final test in refit_without puts back those the refit predicts within the
+// threshold. Returns `refused` unchanged when no hypothesis brings the
+// flagged rows within the allowed fraction.
+CalibrationResult consensus_start(const Robot& robot, const std::vector<Sample>& samples,
+                                  const CalibrationOptions& options, const CalibrationResult& refused) {
+  // Each hypothesis is a full robust fit: only worth it where one row is a
+  // large share of the data.
+  constexpr std::size_t kMaxRows = 20;
+  if (samples.size() > kMaxRows || samples.size() < 3) return refused;
+  std::optional<CalibrationResult> best;
+  std::size_t best_row = 0;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    std::vector<Sample> rest = samples;
+    rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(k));
+    CalibrationResult fit = calibrate_with_restart(robot, rest, options);
+    if (fit.calibration.winches.empty() || (!fit.ok && fit.gross_errors.empty())) continue;
+    if (gross_error_row_fraction(fit, rest.size()) > options.max_rejected_fraction) continue;
+    if (!best || fit.gross_errors.size() < best->gross_errors.size()) {
+      best = std::move(fit);
+      best_row = k;
+    }
+  }
+  if (!best) return refused;
+  CalibrationResult candidate = *best;
+  candidate.ok = false;
+  const int id = samples[best_row].id;
+  const double unknown = std::numeric_limits<double>::quiet_NaN();
+  for (int i = 0; i < kCableCount; ++i) candidate.gross_errors.push_back({id, SensorKind::kEncoder, i, unknown});
+  if (options.cable_model == CableModelKind::kCatenary) {
+    candidate.gross_errors.push_back({id, SensorKind::kForce, robot.reference_cable, unknown});
+  }
+  candidate.rejected_samples = refused.rejected_samples;
+  return candidate;
 }
 
 }  // namespace
@@ -454,6 +497,10 @@ std::vector<Sample> leave_out(const std::vector<Sample>& samples, const std::vec
 
 CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& samples, const CalibrationOptions& options) {
   CalibrationResult result = calibrate_with_restart(robot, samples, options);
+  if (!result.ok && !result.gross_errors.empty() &&
+      gross_error_row_fraction(result, samples.size()) > options.max_rejected_fraction) {
+    result = consensus_start(robot, samples, options, result);
+  }
   if (!result.ok && !result.gross_errors.empty()) {
     result = refit_without(robot, samples, options, result);
   }
