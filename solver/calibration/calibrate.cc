@@ -443,14 +443,15 @@ CalibrationResult refit_without(const Robot& robot, const std::vector<Sample>& s
 // hypothesis that flags the fewest rows wins. Its flagged readings and every
 // reading of the row it left out become the candidates to leave out: the
 // final test in refit_without puts back those the refit predicts within the
-// threshold. Returns `refused` unchanged when no hypothesis brings the
+// threshold. Nothing when the set is large or no hypothesis brings the
 // flagged rows within the allowed fraction.
-CalibrationResult consensus_start(const Robot& robot, const std::vector<Sample>& samples,
-                                  const CalibrationOptions& options, const CalibrationResult& refused) {
+std::optional<CalibrationResult> consensus_start(const Robot& robot, const std::vector<Sample>& samples,
+                                                 const CalibrationOptions& options,
+                                                 const CalibrationResult& robust) {
   // Each hypothesis is a full robust fit: only worth it where one row is a
   // large share of the data.
   constexpr std::size_t kMaxRows = 20;
-  if (samples.size() > kMaxRows || samples.size() < 3) return refused;
+  if (samples.size() > kMaxRows || samples.size() < 3) return std::nullopt;
   std::optional<CalibrationResult> best;
   std::size_t best_row = 0;
   for (std::size_t k = 0; k < samples.size(); ++k) {
@@ -464,7 +465,7 @@ CalibrationResult consensus_start(const Robot& robot, const std::vector<Sample>&
       best_row = k;
     }
   }
-  if (!best) return refused;
+  if (!best) return std::nullopt;
   CalibrationResult candidate = *best;
   candidate.ok = false;
   const int id = samples[best_row].id;
@@ -473,7 +474,7 @@ CalibrationResult consensus_start(const Robot& robot, const std::vector<Sample>&
   if (options.cable_model == CableModelKind::kCatenary) {
     candidate.gross_errors.push_back({id, SensorKind::kForce, robot.reference_cable, unknown});
   }
-  candidate.rejected_samples = refused.rejected_samples;
+  candidate.rejected_samples = robust.rejected_samples;
   return candidate;
 }
 
@@ -499,13 +500,30 @@ CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& sampl
   CalibrationResult result = calibrate_with_restart(robot, samples, options);
   if (!result.ok && !result.gross_errors.empty() &&
       gross_error_row_fraction(result, samples.size()) > options.max_rejected_fraction) {
-    result = consensus_start(robot, samples, options, result);
+    if (auto candidate = consensus_start(robot, samples, options, result)) result = std::move(*candidate);
   }
-  if (!result.ok && !result.gross_errors.empty()) {
-    result = refit_without(robot, samples, options, result);
+  if (result.ok || result.gross_errors.empty()) {
+    if (result.ok) assess_model_fit(result, options);
+    return result;
   }
-  if (result.ok) assess_model_fit(result, options);
-  return result;
+  const CalibrationResult robust = result;
+  result = refit_without(robot, samples, options, robust);
+  if (!result.ok) return result;
+  assess_model_fit(result, options);
+  // A fit that left gross errors out and still misfits may sit where one
+  // bad reading of a small set led it (and left that reading in): the
+  // leave-one-row-out hypotheses get a chance, and the fit that explains
+  // its readings better (chi-square per degree of freedom) is kept.
+  if (!result.misfit) return result;
+  auto candidate = consensus_start(robot, samples, options, robust);
+  if (!candidate) return result;
+  CalibrationResult other = refit_without(robot, samples, options, *candidate);
+  if (!other.ok) return result;
+  assess_model_fit(other, options);
+  auto per_dof = [](const CalibrationResult& r) {
+    return r.degrees_of_freedom > 0 ? r.chi_square / r.degrees_of_freedom : std::numeric_limits<double>::infinity();
+  };
+  return per_dof(other) < per_dof(result) ? other : result;
 }
 
 }  // namespace cdpr
