@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include "solver/model/cable_prediction.h"
 #include "solver/calibration/effect_pose_factor.h"
@@ -419,6 +420,8 @@ CalibrationResult refit_without(const Robot& robot, const std::vector<Sample>& s
     if (!refit.ok || predicted == refit.left_out_residuals.end() ||
         std::abs(predicted->value) > options.rejection_threshold_sigma * misfit_scale) {
       confirmed.push_back(r);
+      // A candidate from a left-out row has no robust residual: the refit's prediction names its size.
+      if (std::isnan(r.value) && predicted != refit.left_out_residuals.end()) confirmed.back().value = predicted->value;
     }
   }
   if (confirmed.size() < robust.gross_errors.size()) {
@@ -432,6 +435,47 @@ CalibrationResult refit_without(const Robot& robot, const std::vector<Sample>& s
     refit.message += "; " + std::to_string(confirmed.size()) + " readings with gross errors left out";
   }
   return refit;
+}
+
+// When the robust fit flags more rows than allowed on a small set, one
+// high-leverage gross error may have pulled the fit into a basin where good
+// rows look bad. Each row is left out in turn and the robust fit redone; the
+// hypothesis that flags the fewest rows wins. Its flagged readings and every
+// reading of the row it left out become the candidates to leave out: the
+// final test in refit_without puts back those the refit predicts within the
+// threshold. Nothing when the set is large or no hypothesis brings the
+// flagged rows within the allowed fraction.
+std::optional<CalibrationResult> consensus_start(const Robot& robot, const std::vector<Sample>& samples,
+                                                 const CalibrationOptions& options,
+                                                 const CalibrationResult& robust) {
+  // Each hypothesis is a full robust fit: only worth it where one row is a
+  // large share of the data.
+  constexpr std::size_t kMaxRows = 20;
+  if (samples.size() > kMaxRows || samples.size() < 3) return std::nullopt;
+  std::optional<CalibrationResult> best;
+  std::size_t best_row = 0;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    std::vector<Sample> rest = samples;
+    rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(k));
+    CalibrationResult fit = calibrate_with_restart(robot, rest, options);
+    if (fit.calibration.winches.empty() || (!fit.ok && fit.gross_errors.empty())) continue;
+    if (gross_error_row_fraction(fit, rest.size()) > options.max_rejected_fraction) continue;
+    if (!best || fit.gross_errors.size() < best->gross_errors.size()) {
+      best = std::move(fit);
+      best_row = k;
+    }
+  }
+  if (!best) return std::nullopt;
+  CalibrationResult candidate = *best;
+  candidate.ok = false;
+  const int id = samples[best_row].id;
+  const double unknown = std::numeric_limits<double>::quiet_NaN();
+  for (int i = 0; i < kCableCount; ++i) candidate.gross_errors.push_back({id, SensorKind::kEncoder, i, unknown});
+  if (options.cable_model == CableModelKind::kCatenary) {
+    candidate.gross_errors.push_back({id, SensorKind::kForce, robot.reference_cable, unknown});
+  }
+  candidate.rejected_samples = robust.rejected_samples;
+  return candidate;
 }
 
 }  // namespace
@@ -454,11 +498,32 @@ std::vector<Sample> leave_out(const std::vector<Sample>& samples, const std::vec
 
 CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& samples, const CalibrationOptions& options) {
   CalibrationResult result = calibrate_with_restart(robot, samples, options);
-  if (!result.ok && !result.gross_errors.empty()) {
-    result = refit_without(robot, samples, options, result);
+  if (!result.ok && !result.gross_errors.empty() &&
+      gross_error_row_fraction(result, samples.size()) > options.max_rejected_fraction) {
+    if (auto candidate = consensus_start(robot, samples, options, result)) result = std::move(*candidate);
   }
-  if (result.ok) assess_model_fit(result, options);
-  return result;
+  if (result.ok || result.gross_errors.empty()) {
+    if (result.ok) assess_model_fit(result, options);
+    return result;
+  }
+  const CalibrationResult robust = result;
+  result = refit_without(robot, samples, options, robust);
+  if (!result.ok) return result;
+  assess_model_fit(result, options);
+  // A fit that left gross errors out and still misfits may sit where one
+  // bad reading of a small set led it (and left that reading in): the
+  // leave-one-row-out hypotheses get a chance, and the fit that explains
+  // its readings better (chi-square per degree of freedom) is kept.
+  if (!result.misfit) return result;
+  auto candidate = consensus_start(robot, samples, options, robust);
+  if (!candidate) return result;
+  CalibrationResult other = refit_without(robot, samples, options, *candidate);
+  if (!other.ok) return result;
+  assess_model_fit(other, options);
+  auto per_dof = [](const CalibrationResult& r) {
+    return r.degrees_of_freedom > 0 ? r.chi_square / r.degrees_of_freedom : std::numeric_limits<double>::infinity();
+  };
+  return per_dof(other) < per_dof(result) ? other : result;
 }
 
 }  // namespace cdpr

@@ -96,6 +96,62 @@ TEST(RobustCalibration, TooManyGrossErrorsAreRefusedWithTheReason) {
   EXPECT_FALSE(result.gross_errors.empty());
 }
 
+TEST(RobustCalibration, OneGrossErrorThatCapturesTheRobustFitOnNinePosesIsStillFound) {
+  // GIVEN 9 poses, nominal anchors 10 m off, one row with a 1.7 m encoder
+  // error whose leverage pulls the robust fit where most rows look bad
+  sim::DatasetConfig config = large(9, 18);
+  config.gross_errors.encoder_fraction = 0.05;
+  config.gross_errors.force_fraction = 0.05;
+  const sim::SimulatedDataset data = simulate(config);
+  // WHEN calibrated with default options
+  const CalibrationResult result = calibrate(data.nominal, data.samples, CalibrationOptions{});
+  // THEN the leave-one-row-out hypotheses find the bad row: the fit is kept,
+  // every planted reading named and only readings of planted rows left out
+  ASSERT_TRUE(result.ok) << result.message;
+  for (const SensorReading& planted : data.truth.outliers) {
+    EXPECT_TRUE(std::any_of(result.calibration.rejected.begin(), result.calibration.rejected.end(),
+                            [&](const SensorReading& r) {
+                              return r.row == planted.row && r.sensor == planted.sensor && r.cable == planted.cable;
+                            }))
+        << "row " << planted.row;
+  }
+  for (const SensorReading& r : result.calibration.rejected) {
+    EXPECT_TRUE(std::isfinite(r.value));
+    EXPECT_TRUE(std::any_of(data.truth.outliers.begin(), data.truth.outliers.end(),
+                            [&](const SensorReading& planted) { return planted.row == r.row; }))
+        << "clean row " << r.row << " left out";
+  }
+  EXPECT_LT(mean_anchor_error(result.calibration, data.truth), 2.0);
+}
+
+TEST(RobustCalibration, AFitThatKeptAGrossErrorAndMisfitsIsRedoneFromTheBadRowLeftOut) {
+  // GIVEN 8 poses of the small robot, nominal anchors 1 m off, a 1.75 m
+  // encoder error and a load-cell spike, where the robust fit flags good
+  // readings, keeps the bad one and its refit misfits
+  sim::DatasetConfig config;
+  config.preset = sim::Preset::kSmall;
+  config.pose_count = 8;
+  config.seed = 45;
+  config.anchor_perturbation_m = 1.0;
+  config.gross_errors.encoder_fraction = 0.05;
+  config.gross_errors.force_fraction = 0.05;
+  const sim::SimulatedDataset data = simulate(config);
+  // WHEN calibrated with default options
+  const CalibrationResult result = calibrate(data.nominal, data.samples, CalibrationOptions{});
+  // THEN the leave-one-row-out hypotheses find the fit that leaves out every
+  // planted reading and fits the rest
+  ASSERT_TRUE(result.ok) << result.message;
+  EXPECT_FALSE(result.misfit) << result.calibration.model_warning;
+  for (const SensorReading& planted : data.truth.outliers) {
+    EXPECT_TRUE(std::any_of(result.calibration.rejected.begin(), result.calibration.rejected.end(),
+                            [&](const SensorReading& r) {
+                              return r.row == planted.row && r.sensor == planted.sensor && r.cable == planted.cable;
+                            }))
+        << "row " << planted.row;
+  }
+  EXPECT_LT(mean_anchor_error(result.calibration, data.truth), 2.0);
+}
+
 TEST(RobustCalibration, ACentreOfMassErrorIsFlaggedAndItsSigmasScaledUp) {
   // GIVEN data whose platform centre of mass is 1 m off the nominal one
   sim::DatasetConfig config = large(90, 1);
