@@ -69,6 +69,11 @@ socket = "$work/control"
 endpoint = "unix:$work/robot/can.sock"
 # The physics runs 20x faster: a 2 m/s cable pays out 40 m per real second.
 max_speed_mps = 100.0
+# The virtual robot's CANopen nodes and pose stream share one thread with its
+# physics, whose equilibrium solve can hold them past the shipped 500 ms
+# (a hard move, a busy machine); a real drive or tracker does not wait for
+# physics. Same for pose_stale_ms below.
+heartbeat_timeout_ms = 2000
 [load_cell]
 # The virtual FT-11 shows kilograms with two decimals.
 endpoint = "rtu:$work/robot/load_cell.tty"
@@ -80,6 +85,7 @@ endpoint = "unix:$work/robot/pose.sock"
 kind = "none"
 [limits]
 settle_timeout_s = 15.0
+pose_stale_ms = 2000
 EOF
 
 echo "== cdpr-calibd (foreground, state in $work/state)"
