@@ -52,7 +52,7 @@ void expect_effect_named(const std::vector<std::string>& effect_options, const s
   // GIVEN the virtual large robot with a hidden effect, as the demo runs it
   std::vector<std::string> robot_options{"--anchor-perturbation", "0.3"};
   robot_options.insert(robot_options.end(), effect_options.begin(), effect_options.end());
-  VirtualRobotProcess rig("large", 35, "", robot_options);
+  VirtualRobotProcess rig("large", 20, "", robot_options);
   auto daemon = rig.start_daemon("daemon");
   ASSERT_TRUE(wait_until([&] { return rig.answers(); }, 30s)) << daemon->log();
   std::this_thread::sleep_for(1s);  // the CANopen nodes' first heartbeats
@@ -70,7 +70,7 @@ void expect_effect_named(const std::vector<std::string>& effect_options, const s
       << state << ": " << reason << "\n" << daemon->log();
   const std::string entry = status["run"]["entry"].string();
   ASSERT_FALSE(entry.empty());
-  EXPECT_GE(data_rows(entry + "/samples.csv"), 30) << read_text(entry + "/samples.csv");
+  EXPECT_GE(data_rows(entry + "/samples.csv"), 18) << read_text(entry + "/samples.csv");
   EXPECT_TRUE(std::filesystem::exists(entry + "/robot.toml"));
   // AND the model check after the solve names the effect (calibctl status;
   // calibctl show too when the fit was committed)
