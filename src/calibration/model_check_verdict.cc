@@ -1,5 +1,7 @@
 #include "src/calibration/model_check_verdict.h"
 
+#include <algorithm>
+
 #include "src/calibration/message_text.h"
 
 namespace cdpr::calibration {
@@ -40,6 +42,22 @@ std::string model_check_verdict(const Diagnosis& diagnosis) {
   }
   if (effects.empty()) return "model explains the data (" + misfit + ")";
   return effects + " (explains the data: " + misfit + ")";
+}
+
+std::vector<std::string> model_check_terms(std::string_view verdict) {
+  // The verdict lists each effect as "name: values", the effects separated by "; ".
+  std::vector<std::string> terms;
+  std::size_t begin = 0;
+  while (begin < verdict.size()) {
+    const std::size_t end = std::min(verdict.find("; ", begin), verdict.size());
+    const std::string_view piece = verdict.substr(begin, end - begin);
+    const std::size_t colon = piece.find(": ");
+    if (colon != std::string_view::npos && effect_from_model_name(piece.substr(0, colon))) {
+      terms.emplace_back(piece.substr(0, colon));
+    }
+    begin = end + 2;
+  }
+  return terms;
 }
 
 }  // namespace cdpr::calibration

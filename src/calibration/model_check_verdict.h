@@ -12,11 +12,19 @@
 // only informs: the committed calibration keeps the daemon's model.
 
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "solver/diagnosis/diagnosis.h"
 
 namespace cdpr::calibration {
 
 std::string model_check_verdict(const Diagnosis& diagnosis);
+
+// The model term names a verdict of model_check_verdict() names (with their
+// values), in its order: what `calibctl commit --with-term` would add.
+// Empty when it names none (the model explains the data, structure remains
+// unexplained, the check could not run).
+std::vector<std::string> model_check_terms(std::string_view verdict);
 
 }  // namespace cdpr::calibration

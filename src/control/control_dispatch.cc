@@ -7,7 +7,7 @@
 namespace cdpr::control {
 
 std::string respond(std::string_view request_line, calibration::CalibrationStateMachine& machine,
-                    store::CalibrationStore& store, hal::TimeUs now_us) {
+                    store::CalibrationStore& store, hal::TimeUs now_us, RefitService* refits) {
   const auto request = parse_request(request_line);
   if (!request) return format_error_response(request.error());
   switch (request->kind) {
@@ -19,7 +19,8 @@ std::string respond(std::string_view request_line, calibration::CalibrationState
         return format_error_response(machine.status().note);
       }
       return format_ok_response("aborted: " + machine.status().reason);
-    case RequestKind::kStatus: return format_status_response(machine.status(), now_us);
+    case RequestKind::kStatus:
+      return format_status_response(machine.status(), now_us, refits ? refits->refit_status() : std::nullopt);
     case RequestKind::kResetFaults:
       if (!machine.request_reset_faults(now_us)) return format_error_response(machine.status().note);
       return format_ok_response(machine.status().note);
@@ -60,6 +61,15 @@ std::string respond(std::string_view request_line, calibration::CalibrationState
                                      committed.error().message());
       }
       return format_ok_response("committed calibration " + std::to_string(*committed) + " from " + pending.dir());
+    }
+    case RequestKind::kRefit: {
+      if (calibration::is_running(machine.status().state)) {
+        return format_error_response("refit refused: a calibration is running (wait for its end or abort it)");
+      }
+      if (!refits) return format_error_response("refit refused: this daemon cannot refit runs");
+      const auto started = refits->start_refit(request->run, request->terms);
+      if (!started) return format_error_response("refit refused: " + started.error());
+      return format_ok_response(*started);
     }
   }
   return format_error_response("unhandled request");

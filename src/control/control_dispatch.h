@@ -9,18 +9,23 @@
 // validation compares against the current file and its commit would
 // overwrite theirs). commit commits the fit a failed commit kept in
 // <state>/pending (pending_calibration.h); after either, the machine's view
-// of the store's problems is refreshed.
+// of the store's problems is refreshed. refit is refused while a
+// calibration runs too, and handed to `refits` (refit_service.h) otherwise,
+// which fits on a worker: the answer says it started (or why not), status
+// says what became of it.
 
 #include <string>
 #include <string_view>
 
 #include "hal/clock.h"
 #include "src/calibration/calibration_state_machine.h"
+#include "src/control/refit_service.h"
 #include "src/store/calibration_store.h"
 
 namespace cdpr::control {
 
+// `refits` may be null: refit is then refused as not available.
 std::string respond(std::string_view request_line, calibration::CalibrationStateMachine& machine,
-                    store::CalibrationStore& store, hal::TimeUs now_us);
+                    store::CalibrationStore& store, hal::TimeUs now_us, RefitService* refits = nullptr);
 
 }  // namespace cdpr::control

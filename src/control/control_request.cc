@@ -12,7 +12,7 @@ struct Command {
   bool takes_seq;
 };
 
-constexpr std::array<Command, 8> kCommands = {{
+constexpr std::array<Command, 9> kCommands = {{
     {"start", RequestKind::kStart, false},
     {"abort", RequestKind::kAbort, false},
     {"status", RequestKind::kStatus, false},
@@ -21,10 +21,11 @@ constexpr std::array<Command, 8> kCommands = {{
     {"rollback", RequestKind::kRollback, true},
     {"commit", RequestKind::kCommit, false},
     {"reset-faults", RequestKind::kResetFaults, false},
+    {"refit", RequestKind::kRefit, false},
 }};
 
 constexpr const char* kExpected =
-    "expected start, abort, status, show, history, rollback <seq>, commit or reset-faults";
+    "expected start, abort, status, show, history, rollback <seq>, commit, reset-faults or refit <terms> [<run>]";
 
 bool is_blank(char c) { return c == ' ' || c == '\t'; }
 
@@ -37,6 +38,29 @@ std::string quoted(std::string_view word) {
   }
   if (word.size() > 32) text += "...";
   return text + "'";
+}
+
+// 1..999999999 from its digits; 0 when `digits` is not such a number.
+int positive_number(std::string_view digits) {
+  if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string_view::npos) return 0;
+  int number = 0;
+  for (const char c : digits) number = number * 10 + (c - '0');
+  return number;
+}
+
+// `refit <terms> [<run>]`: the run as 7 or as its entry name run-000007.
+Expected<Request, std::string> parse_refit(const std::vector<std::string_view>& words) {
+  if (words.size() < 2 || words.size() > 3) {
+    return Unexpected{std::string("refit takes one or two arguments: <terms> [<run>]")};
+  }
+  Request request{RequestKind::kRefit, 0, std::string(words[1]), 0};
+  if (words.size() == 3) {
+    std::string_view run = words[2];
+    if (run.starts_with("run-")) run.remove_prefix(4);
+    request.run = positive_number(run);
+    if (request.run < 1) return Unexpected{"run " + quoted(words[2]) + " is not a run number (7 or run-000007)"};
+  }
+  return request;
 }
 
 }  // namespace
@@ -68,24 +92,17 @@ Expected<Request, std::string> parse_request(std::string_view line) {
   }
   if (words.empty()) return Unexpected{std::string("empty request (") + kExpected + ")"};
 
+  if (words[0] == "refit") return parse_refit(words);
   for (const Command& command : kCommands) {
     if (words[0] != command.name) continue;
     if (!command.takes_seq) {
       if (words.size() != 1) return Unexpected{std::string(command.name) + " takes no argument"};
-      return Request{command.kind, 0};
+      return Request{command.kind, 0, {}, 0};
     }
     if (words.size() != 2) return Unexpected{std::string(command.name) + " takes one argument: <seq>"};
-    const std::string_view digits = words[1];
-    int seq = 0;
-    const bool all_digits = digits.size() <= 9 && !digits.empty() &&
-                            digits.find_first_not_of("0123456789") == std::string_view::npos;
-    if (all_digits) {
-      for (const char c : digits) seq = seq * 10 + (c - '0');
-    }
-    if (!all_digits || seq < 1) {
-      return Unexpected{"sequence number " + quoted(digits) + " is not an integer in 1..999999999"};
-    }
-    return Request{command.kind, seq};
+    const int seq = positive_number(words[1]);
+    if (seq < 1) return Unexpected{"sequence number " + quoted(words[1]) + " is not an integer in 1..999999999"};
+    return Request{command.kind, seq, {}, 0};
   }
   return Unexpected{"unknown command " + quoted(words[0]) + " (" + kExpected + ")"};
 }

@@ -13,6 +13,10 @@
 //   history          the stored versions
 //   rollback <seq>   make stored version <seq> current again (seq: 1..999999999)
 //   commit           commit the fit a failed commit kept in <state>/pending
+//   refit <terms> [<run>]  re-fit a kept run's samples with the catenary plus
+//                    <terms> (model term names, comma-separated, e.g.
+//                    load_cell_bias) and commit it when it validates; <run>:
+//                    7 or run-000007, the newest kept run when absent
 //   reset-faults     clear the devices' latched faults (not during a run)
 //
 // Every request gets exactly one response line (control_response.h). The
@@ -29,7 +33,7 @@ namespace cdpr::control {
 inline constexpr std::size_t kMaxRequestBytes = 256;
 
 enum class RequestKind {
-  kStart, kAbort, kStatus, kShow, kHistory, kRollback, kCommit, kResetFaults
+  kStart, kAbort, kStatus, kShow, kHistory, kRollback, kCommit, kResetFaults, kRefit
 };
 
 const char* to_string(RequestKind kind);
@@ -37,6 +41,10 @@ const char* to_string(RequestKind kind);
 struct Request {
   RequestKind kind = RequestKind::kStatus;
   int seq = 0;  // kRollback only
+  // kRefit only: the terms as given (checked against the known ones by the
+  // daemon, which names them in its refusal) and the run, 0 for the newest.
+  std::string terms;
+  int run = 0;
 };
 
 // Parses one line (with or without its "\n"). The error is a short reason

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
+#include "src/calibration/model_check_verdict.h"
 #include "src/formats/number_text.h"
 
 namespace cdpr::control {
@@ -66,6 +67,19 @@ Json string_array(const std::vector<std::string>& texts) {
   return array;
 }
 
+// The last refit (refit_service.h); null before the first.
+Json refit_json(const std::optional<RefitStatus>& refit) {
+  if (!refit) return nullptr;
+  Json json;
+  json["run"] = refit->run;
+  json["terms"] = refit->terms;
+  json["state"] = refit->state;
+  json["message"] = refit->message;
+  json["committed_seq"] = refit->committed_seq;
+  json["entry"] = refit->entry;
+  return json;
+}
+
 }  // namespace
 
 std::string format_error_response(std::string_view reason) {
@@ -82,7 +96,8 @@ std::string format_ok_response(std::string_view message) {
   return line(json);
 }
 
-std::string format_status_response(const calibration::CalibrationStatus& status, hal::TimeUs now_us) {
+std::string format_status_response(const calibration::CalibrationStatus& status, hal::TimeUs now_us,
+                                   const std::optional<RefitStatus>& refit) {
   Json json;
   json["ok"] = true;
   json["state"] = calibration::to_string(status.state);
@@ -114,8 +129,10 @@ std::string format_status_response(const calibration::CalibrationStatus& status,
     run["outcome"] = status.run_outcome;
     run["samples"] = status.samples;
     run["diagnosis"] = status.run_diagnosis;
+    run["named_terms"] = string_array(calibration::model_check_terms(status.run_diagnosis));
     json["run"] = std::move(run);
   }
+  json["refit"] = refit_json(refit);
   return line(json);
 }
 
@@ -169,6 +186,7 @@ std::string format_show_response(const std::optional<store::CurrentCalibration>&
       entry["skipped"] = run->log.skipped;
       entry["robot_time_s"] = run->log.robot_time_s;
       entry["diagnosis"] = run->log.diagnosis;
+      entry["named_terms"] = string_array(calibration::model_check_terms(run->log.diagnosis));
       // The report beside the calibration; null when the run has none (an older daemon's).
       const std::string report = run->path + "/" + store::RunHistory::kReportName;
       std::error_code error;

@@ -8,21 +8,29 @@
 //             "samples":2,"skipped":0,"progress":0.12,"elapsed_s":41.2,
 //             "reason":"","note":"","detail":"platform moving: ...","device_faults":"",
 //             "committed_seq":0,"interrupted":"","store_problems":[],"pending_commit":false,
-//             "run":{"entry":"/var/lib/cdpr-calib/history/run-000007","outcome":"running","samples":2}}
+//             "run":{"entry":"/var/lib/cdpr-calib/history/run-000007","outcome":"running","samples":2,
+//                    "diagnosis":"","named_terms":[]},
+//             "refit":{"run":"run-000007","terms":"load_cell_bias","state":"committed","message":"..",
+//                      "committed_seq":5,"entry":"/var/lib/cdpr-calib/history/run-000008"}}
 //            elapsed_s: since the last run started (to its end when finished); null if never run
 //            device_faults: the devices' latched faults until reset-faults ("" when none)
 //            interrupted: "run interrupted at <time>, waypoint k of n ..." when a daemon died
 //            mid-run, until the next start; store_problems: unreadable stored files, one
 //            sentence each; pending_commit: a failed commit's fit waits for `commit`;
 //            run: the last run's history entry (docs/FORMATS.md "History entry of a run"; entry
-//            "" when none is kept), its outcome as in run.toml and its samples; null before a run
+//            "" when none is kept), its outcome as in run.toml, its samples, the model check's
+//            verdict ("" until it ran) and the model terms that verdict names (what
+//            `refit <terms>` would add); null before a run
+//            refit: the last refit requested (refit_service.h: state running, committed,
+//            refused or failed); null before the first
 //   show     {"ok":true,"present":true,"seq":4,"created":"2026-11-22T10:15:00Z","robot":"large",
 //             "model":["catenary"],"samples":35,
 //             "winches":[{"anchor":[x,y,z],"anchor_sigma":[..],"offset":3.2,"offset_sigma":0.03},...],
 //             "fit":{"cost_initial":..,"cost_final":..,"iterations":14,"rms_encoder":..,"rms_force":..},
 //             "model_warning":"","rejected":[{"row":12,"sensor":"encoder","cable":3,"residual":-95.4},...],
 //             "run":{"entry":"/var/lib/cdpr-calib/history/run-000007","outcome":"committed","samples":35,
-//                    "skipped":0,"robot_time_s":812.5,"diagnosis":""}}
+//                    "skipped":0,"robot_time_s":812.5,"diagnosis":"","named_terms":[],
+//                    "report":"/var/lib/cdpr-calib/history/run-000007/report.html"}}
 //            model_warning: why the model does not fit the data ("" when it fits); rejected: the
 //            readings left out of the fit as gross errors (calibration.toml [[rejected]]; residual
 //            in sigmas at the robust fit); run: the history entry of the run that produced this
@@ -41,6 +49,7 @@
 
 #include "hal/clock.h"
 #include "src/calibration/calibration_state.h"
+#include "src/control/refit_service.h"
 #include "src/store/calibration_store.h"
 #include "src/store/run_history.h"
 
@@ -48,7 +57,8 @@ namespace cdpr::control {
 
 std::string format_error_response(std::string_view reason);
 std::string format_ok_response(std::string_view message);
-std::string format_status_response(const calibration::CalibrationStatus& status, hal::TimeUs now_us);
+std::string format_status_response(const calibration::CalibrationStatus& status, hal::TimeUs now_us,
+                                   const std::optional<RefitStatus>& refit = std::nullopt);
 std::string format_show_response(const std::optional<store::CurrentCalibration>& current,
                                  const std::optional<store::RunEntry>& run = std::nullopt);
 std::string format_history_response(const std::vector<store::HistoryEntry>& history);

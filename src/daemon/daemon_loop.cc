@@ -41,6 +41,8 @@ DaemonLoop::DaemonLoop(const DaemonConfig& config, const Robot& robot, DaemonDev
   recorder_ = std::make_unique<RunRecorder>(
       store_.state_dir(), static_cast<std::uintmax_t>(config_.history.budget_mb * kBytesPerMb), model_check,
       config_.solver);
+  refitter_ = std::make_unique<RunRefitter>(robot_, store_.history_dir(), store_, config_.solver,
+                                            config_.calibrator.validation, utc_now_rfc3339, log_);
 }
 
 DaemonLoop::~DaemonLoop() { shutdown(); }
@@ -142,7 +144,7 @@ void DaemonLoop::log_device_faults() {
 }
 
 std::string DaemonLoop::handle_request(std::string_view line) {
-  return control::respond(line, *machine_, store_, clock_.now_us());
+  return control::respond(line, *machine_, store_, clock_.now_us(), refitter_.get());
 }
 
 void DaemonLoop::run(const std::atomic<bool>& stop) {
@@ -173,6 +175,7 @@ void DaemonLoop::step(hal::TimeUs now_us) {
   if (!machine_->owns_hardware()) service_idle_devices(now_us);
   machine_->step(now_us);
   manage_solve(now_us);
+  manage_refit();
   track_run();
   record_run();
   log_device_faults();
@@ -232,6 +235,14 @@ void DaemonLoop::manage_solve(hal::TimeUs now_us) {
   solve_ = std::async(std::launch::async, [robot = robot_, samples = machine_->samples(), options = config_.solver] {
     return calibrate(robot, samples, options);
   });
+}
+
+void DaemonLoop::manage_refit() {
+  if (!refitter_->poll(calibration::is_running(machine_->status().state))) return;
+  std::optional<CommittedRefit> committed = refitter_->take_committed();
+  if (!committed) return;
+  machine_->refresh_store_problems();
+  refitter_->note_entry(recorder_->keep_refit(std::move(*committed)));
 }
 
 void DaemonLoop::report(hal::TimeUs /*now_us*/) {

@@ -18,6 +18,9 @@
 //   - keeps every run's data in the history (run_recorder.h; written on a
 //     thread of its own, within [history] budget_mb; the model check after
 //     each solve runs there too),
+//   - refits a kept run with an extra model term when the operator asks
+//     (run_refitter.h: the `refit` request, on a worker of its own), and
+//     keeps a committed refit in the history with its report,
 //   - reports READY, STATUS and WATCHDOG through the ServiceNotifier.
 // shutdown() stops the winches (abort a run: halt; then quick stop) and
 // closes the devices; the owner calls it on SIGTERM and exits 0.
@@ -43,6 +46,7 @@
 #include "src/daemon/daemon_config.h"
 #include "src/daemon/run_marker.h"
 #include "src/daemon/run_recorder.h"
+#include "src/daemon/run_refitter.h"
 #include "src/store/calibration_store.h"
 
 namespace cdpr::daemon {
@@ -96,6 +100,8 @@ class DaemonLoop {
   void step(hal::TimeUs now_us);
   void service_idle_devices(hal::TimeUs now_us);
   void manage_solve(hal::TimeUs now_us);
+  // A refit's result taken, logged and, when committed, kept in the history.
+  void manage_refit();
   void report(hal::TimeUs now_us);
   std::string handle_request(std::string_view line);
   // Start-up: a run marker left by a daemon that died mid-run, and the
@@ -119,6 +125,7 @@ class DaemonLoop {
   std::unique_ptr<calibration::CalibrationStateMachine> machine_;
   std::unique_ptr<ControlServer> server_;
   std::unique_ptr<RunRecorder> recorder_;
+  std::unique_ptr<RunRefitter> refitter_;
   std::future<CalibrationResult> solve_;
   bool solving_ = false;
 

@@ -1,7 +1,6 @@
 #include "src/daemon/run_recorder.h"
 
 #include <cstdio>
-#include <filesystem>
 #include <utility>
 
 #include "solver/diagnosis/diagnosis.h"
@@ -79,6 +78,10 @@ void RunRecorder::report(const std::string& message) {
   messages_.push_back(message);
 }
 
+void RunRecorder::write_file(int run, const char* name, const std::string& content) {
+  if (auto written = history_.write(run, name, content); !written) report("run history: " + written.error().message());
+}
+
 void RunRecorder::prune() {
   // The current calibration's run and a pending fit's stay, whatever the budget.
   std::vector<std::string> spared;
@@ -120,12 +123,8 @@ void RunRecorder::track(calibration::CalibrationStateMachine& machine, const Rob
   if (status.started_us < 0) return;
   const formats::RunLog& log = machine.run_log();
   if (status.started_us != run_started_us_) {
-    if (next_run_ <= 0) {
-      const auto next = history_.next_run();
-      next_run_ = next ? *next : 1;
-    }
     run_started_us_ = status.started_us;
-    run_ = next_run_++;
+    run_ = take_run_number();
     waypoints_queued_ = faults_queued_ = 0;
     fit_queued_ = solved_ = false;
     report_result_.reset();
@@ -134,9 +133,7 @@ void RunRecorder::track(calibration::CalibrationStateMachine& machine, const Rob
     post([this, run = run_, robot_text = formats::format_robot_toml(robot)] {
       reported_.clear();
       if (auto made = history_.create(run); !made) return report("run history: " + made.error().message());
-      if (auto written = history_.write(run, store::RunHistory::kRobotName, robot_text); !written) {
-        report("run history: " + written.error().message());
-      }
+      write_file(run, store::RunHistory::kRobotName, robot_text);
     });
   }
   solved_ = solved_ || status.state == calibration::CalibrationState::kSolve;
@@ -167,11 +164,7 @@ void RunRecorder::track(calibration::CalibrationStateMachine& machine, const Rob
   // Copies: the model check below needs them too.
   post([this, run = run_, snapshot, samples, samples_changed,
         fit_text = std::move(fit_text), ended] {
-    const auto write = [&](const char* name, const std::string& content) {
-      if (auto written = history_.write(run, name, content); !written) {
-        report("run history: " + written.error().message());
-      }
-    };
+    const auto write = [&](const char* name, const std::string& content) { write_file(run, name, content); };
     // Samples before the log that counts them; the fit before the log that says it was committed.
     if (samples_changed) write(store::RunHistory::kSamplesName, formats::format_samples_csv(samples));
     if (!fit_text.empty()) write(store::RunHistory::kCalibrationName, fit_text);
@@ -180,7 +173,7 @@ void RunRecorder::track(calibration::CalibrationStateMachine& machine, const Rob
   });
   if (with_report) {
     post([this, run = run_, snapshot, robot, samples, fit = std::move(*report_result_)] {
-      write_report(run, snapshot, robot, samples, fit);
+      write_report(run, snapshot, robot, samples, *report_fit_, fit);
     });
     report_result_.reset();
   }
@@ -191,6 +184,39 @@ void RunRecorder::track(calibration::CalibrationStateMachine& machine, const Rob
   }
 }
 
+int RunRecorder::take_run_number() {
+  if (next_run_ <= 0) {
+    const auto next = history_.next_run();
+    next_run_ = next ? *next : 1;
+  }
+  return next_run_++;
+}
+
+std::string RunRecorder::keep_refit(CommittedRefit refit) {
+  const int run = take_run_number();
+  formats::RunLog log = refit.source_log;
+  log.refit_of = refit.source_log.run;
+  log.run = run;
+  log.outcome = formats::kRunCommitted;
+  log.reason = "refit of " + store::RunHistory::entry_name(log.refit_of) + " with the terms " + refit.terms +
+               " (operator's choice): committed calibration " + std::to_string(refit.seq);
+  log.calibration = refit.seq;
+  log.diagnosis.clear();
+  log.started = log.finished = refit.fit.calibration.created;
+  post([this, run, log = std::move(log), refit = std::move(refit)] {
+    reported_.clear();
+    const auto write = [&](const char* name, const std::string& content) { write_file(run, name, content); };
+    if (auto made = history_.create(run); !made) return report("run history: " + made.error().message());
+    write(store::RunHistory::kRobotName, formats::format_robot_toml(refit.robot));
+    write(store::RunHistory::kSamplesName, formats::format_samples_csv(refit.samples));
+    write(store::RunHistory::kCalibrationName, formats::format_calibration_toml(refit.fit.calibration));
+    write(store::RunHistory::kLogName, formats::format_run_log_toml(log));
+    write_report(run, log, refit.robot, refit.samples, refit.options, refit.fit);
+    prune();
+  });
+  return history_.entry_path(run);
+}
+
 void RunRecorder::check_model(int run, formats::RunLog log, const Robot& robot, const std::vector<Sample>& samples) {
   {
     // A stopping daemon writes the run's data but does not start a check
@@ -199,12 +225,9 @@ void RunRecorder::check_model(int run, formats::RunLog log, const Robot& robot, 
     if (stopping_) return;
   }
   // A run pruned meanwhile (a budget of nothing) has no log to add to.
-  std::error_code error;
-  if (!std::filesystem::is_directory(history_.entry_path(run), error)) return;
+  if (!history_.exists(run)) return;
   log.diagnosis = calibration::model_check_verdict(diagnose(robot, samples, *model_check_));
-  if (auto written = history_.write(run, store::RunHistory::kLogName, formats::format_run_log_toml(log)); !written) {
-    report("run history: " + written.error().message());
-  }
+  write_file(run, store::RunHistory::kLogName, formats::format_run_log_toml(log));
   std::lock_guard lock(mutex_);
   messages_.push_back("model check of " + store::RunHistory::entry_name(run) + ": " + log.diagnosis);
   checked_run_ = run;
@@ -223,7 +246,14 @@ std::string seconds_text(double s) {
 std::vector<std::pair<std::string, std::string>> run_facts(const formats::RunLog& log) {
   std::vector<std::pair<std::string, std::string>> facts;
   facts.emplace_back("run", store::RunHistory::entry_name(log.run) + ", " + log.outcome + ", started " + log.started);
-  facts.emplace_back("robot time", seconds_text(log.robot_time_s));
+  if (log.refit_of > 0) {
+    facts.emplace_back("refit", "the samples of " + store::RunHistory::entry_name(log.refit_of) +
+                                    " fitted again with the model above, committed by the operator's choice");
+  }
+  // run.toml's robot time is the daemon's monotonic clock from start to end:
+  // the robot's own time only when the robot runs in real time (a virtual
+  // robot's runs its time scale faster), so the card names the clock.
+  facts.emplace_back("run time", seconds_text(log.robot_time_s) + " on the daemon's clock, start to end");
   facts.emplace_back("waypoints", std::to_string(log.waypoints_planned) + " planned, " + std::to_string(log.samples) +
                                       " sampled, " + std::to_string(log.skipped) + " skipped");
   for (const formats::RunWaypoint& w : log.waypoints) {
@@ -236,17 +266,13 @@ std::vector<std::pair<std::string, std::string>> run_facts(const formats::RunLog
 }  // namespace
 
 void RunRecorder::write_report(int run, const formats::RunLog& log, const Robot& robot,
-                               const std::vector<Sample>& samples, const CalibrationResult& fit) {
+                               const std::vector<Sample>& samples, const CalibrationOptions& options,
+                               const CalibrationResult& fit) {
   // A run pruned meanwhile (a budget of nothing) has no entry to write into.
-  std::error_code error;
-  if (!std::filesystem::is_directory(history_.entry_path(run), error)) return;
-  const HeldOutEvaluation residuals = report::fitted_residuals(robot, samples, *report_fit_, fit);
-  const report::CalibrationReport content{"Calibration of robot " + robot.name, &robot, &fit, &residuals,
-                                          std::nullopt, run_facts(log)};
-  if (auto written = history_.write(run, store::RunHistory::kReportName, report::calibration_report_html(content));
-      !written) {
-    report("run history: " + written.error().message());
-  }
+  if (!history_.exists(run)) return;
+  const std::string html =
+      report::fitted_calibration_report_html(robot, samples, options, fit, std::nullopt, run_facts(log));
+  write_file(run, store::RunHistory::kReportName, html);
 }
 
 }  // namespace cdpr::daemon

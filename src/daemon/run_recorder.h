@@ -37,6 +37,7 @@
 #include "solver/diagnosis/diagnosis_options.h"
 #include "solver/model/robot.h"
 #include "src/calibration/calibration_state_machine.h"
+#include "src/daemon/run_refitter.h"
 #include "src/store/run_history.h"
 
 namespace cdpr::daemon {
@@ -65,6 +66,13 @@ class RunRecorder {
   // check of its run is done, puts its verdict there too.
   void track(calibration::CalibrationStateMachine& machine, const Robot& robot);
 
+  // Between runs (loop thread): keeps a refit the operator had committed
+  // (run_refitter.h) as an entry of its own, so that `calibctl show` finds
+  // its report like a run's: the refitted run's robot.toml, samples.csv and
+  // log (run.toml `refit_of` names that run), the refit's calibration.toml
+  // and its report.html. Returns the entry's path; written on the thread.
+  std::string keep_refit(CommittedRefit refit);
+
   // Failed writes and prunings since the last call, one sentence each.
   std::vector<std::string> take_messages();
 
@@ -83,11 +91,16 @@ class RunRecorder {
   // On the writer thread: notes a failure once per message and run.
   void report(const std::string& message);
   void prune();
+  // On the writer thread: file `name` of entry `run`, a failure reported.
+  void write_file(int run, const char* name, const std::string& content);
   // On the writer thread: the model check of a finished run, its verdict into run.toml.
   void check_model(int run, formats::RunLog log, const Robot& robot, const std::vector<Sample>& samples);
   // On the writer thread: report.html of a run that ended with a validated fit.
+  // `options`: those the fit was made with.
   void write_report(int run, const formats::RunLog& log, const Robot& robot, const std::vector<Sample>& samples,
-                    const CalibrationResult& fit);
+                    const CalibrationOptions& options, const CalibrationResult& fit);
+  // Loop thread: the number of the next entry.
+  int take_run_number();
 
   store::RunHistory history_;
   std::string state_dir_;

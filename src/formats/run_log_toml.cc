@@ -23,7 +23,8 @@ RunLog read_run_log(TomlReader& reader, const toml::table& root) {
                      {"finished", Presence::kOptional}, {"robot_time_s", Presence::kRequired},
                      {"waypoints_planned", Presence::kRequired}, {"samples", Presence::kRequired},
                      {"skipped", Presence::kRequired}, {"calibration", Presence::kOptional},
-                     {"diagnosis", Presence::kOptional}, {"waypoint", Presence::kOptional},
+                     {"diagnosis", Presence::kOptional}, {"refit_of", Presence::kOptional},
+                     {"waypoint", Presence::kOptional},
                      {"fault", Presence::kOptional}});
   RunLog log;
   if (const auto format = reader.integer(root, "format", ""); !reader.failed() && format != kFormatVersion) {
@@ -47,6 +48,7 @@ RunLog read_run_log(TomlReader& reader, const toml::table& root) {
   log.skipped = reader.count(root, "skipped", "");
   if (root.contains("calibration")) log.calibration = reader.count(root, "calibration", "");
   if (root.contains("diagnosis")) log.diagnosis = reader.string(root, "diagnosis", "");
+  if (root.contains("refit_of")) log.refit_of = reader.count(root, "refit_of", "");
   // Absent arrays are empty: a run that ended before its first waypoint, a run without faults.
   const auto tables = [&](const char* key) {
     return root.contains(key) ? reader.tables(root, key, "") : std::vector<const toml::table*>{};
@@ -90,6 +92,7 @@ std::string format_run_log_toml(const RunLog& log) {
   append_line(out, "skipped = " + std::to_string(log.skipped), "waypoints without equilibrium");
   if (log.calibration > 0) append_line(out, "calibration = " + std::to_string(log.calibration), "history sequence number");
   if (!log.diagnosis.empty()) append_line(out, "diagnosis = " + toml_string(log.diagnosis));
+  if (log.refit_of > 0) append_line(out, "refit_of = " + std::to_string(log.refit_of), "the run whose samples were refitted");
   for (const RunWaypoint& waypoint : log.waypoints) {
     out += '\n';
     append_line(out, "[[waypoint]]");

@@ -50,6 +50,9 @@ struct RunLog {
   int skipped = 0;
   int calibration = 0;         // store sequence number committed by this run; 0 none
   std::string diagnosis;       // the discrepancy check's verdict on this run's data; empty: not run
+  // A refit's entry (an operator's `calibctl commit --with-term`): the run
+  // whose samples it refitted, whose log it copies; 0 for a run of the robot.
+  int refit_of = 0;
   std::vector<RunWaypoint> waypoints;
   std::vector<RunFault> faults;
 };

@@ -120,4 +120,14 @@ std::string calibration_report_html(const CalibrationReport& r) {
   return html + page_end();
 }
 
+std::string fitted_calibration_report_html(const Robot& robot, const std::vector<Sample>& samples,
+                                           const CalibrationOptions& options, const CalibrationResult& fit,
+                                           const std::optional<Truth>& truth,
+                                           std::vector<std::pair<std::string, std::string>> facts) {
+  const HeldOutEvaluation residuals = fitted_residuals(robot, samples, options, fit);
+  const CalibrationReport report{"Calibration of robot " + robot.name, &robot, &fit, &residuals, truth,
+                                 std::move(facts)};
+  return calibration_report_html(report);
+}
+
 }  // namespace cdpr::report

@@ -35,4 +35,13 @@ HeldOutEvaluation fitted_residuals(const Robot& robot, const std::vector<Sample>
 
 std::string calibration_report_html(const CalibrationReport& report);
 
+// The report of a finished fit of `robot` to `samples` (as made with
+// `options`), titled "Calibration of robot <name>", with its residuals
+// (fitted_residuals): what `cdpr-calib solve --report` and the daemon write.
+// `facts`: lines about the data (its files, or the run that measured it).
+std::string fitted_calibration_report_html(const Robot& robot, const std::vector<Sample>& samples,
+                                           const CalibrationOptions& options, const CalibrationResult& fit,
+                                           const std::optional<Truth>& truth,
+                                           std::vector<std::pair<std::string, std::string>> facts);
+
 }  // namespace cdpr::report

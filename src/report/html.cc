@@ -11,7 +11,8 @@ namespace {
 // Sized for the screen and for A4 (print margins 12 mm: 186 mm of text):
 // plots scale down with their container (viewBox, max-width 100%), tables
 // wrap their cells, preformatted text wraps, nothing sets a width wider
-// than the page. Collapsed sections print open.
+// than the page. Collapsed sections print open: the print rule on
+// ::details-content where the browser has it, and kPrintScript for the rest.
 const char* const kStyle =
     "*{box-sizing:border-box}"
     "body{font-family:system-ui,sans-serif;font-size:15px;line-height:1.4;max-width:60rem;margin:0 auto;"
@@ -37,6 +38,14 @@ const char* const kStyle =
     "@media print{body{font-size:10pt;max-width:none;padding:0}.plots{grid-template-columns:1fr 1fr}"
     "h2{break-after:avoid}.verdict{break-inside:avoid}}"
     "@media print{details::details-content{content-visibility:visible;display:contents}}";
+
+// A stylesheet cannot open <details>: before printing every closed one is
+// opened, and closed again after, so that paper shows what the screen folds.
+const char* const kPrintScript =
+    "addEventListener('beforeprint',()=>{for(const d of document.querySelectorAll('details:not([open])')){"
+    "d.open=true;d.dataset.printOpened='1'}});"
+    "addEventListener('afterprint',()=>{for(const d of document.querySelectorAll('details[data-print-opened]')){"
+    "d.open=false;delete d.dataset.printOpened}});";
 
 bool numeric(const std::string& cell) {
   if (cell.empty()) return false;
@@ -82,7 +91,8 @@ std::string format(const char* fmt, ...) {
 std::string page_begin(const std::string& title) {
   return "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
          "<meta name=\"viewport\" content=\"width=device-width,initial-scale=1\"><title>" +
-         html_escape(title) + "</title><style>" + kStyle + "</style></head><body>\n";
+         html_escape(title) + "</title><style>" + kStyle + "</style><script>" + kPrintScript +
+         "</script></head><body>\n";
 }
 
 std::string page_end() { return "</body></html>\n"; }

@@ -195,9 +195,13 @@ std::string anchor_plots(const Robot& nominal, const CalibrationResult& fit, con
   }
   double half_width = 0.0;
   for (const AnchorTopView& v : views) half_width = std::max(half_width, anchor_view_half_width(v));
-  std::string html = "<div class=\"plots\">" + figure(svg_anchor_layout(views), "filled: fitted; open: nominal");
+  std::string html = "<div class=\"plots\">" + figure(svg_anchor_layout(views),
+                                                     "filled dot: where the fit puts the anchor; open circle: its "
+                                                     "nominal position in robot.toml");
   for (const AnchorTopView& v : views) {
-    html += figure(svg_anchor_top_view(v, half_width), "solid: 1 sigma, dashed: 3 sigma, all panels at one scale");
+    html += figure(svg_anchor_top_view(v, half_width),
+                   "centred on the fitted anchor (filled dot); solid: 1 sigma, dashed: 3 sigma; open circle: nominal "
+                   "(an arrow to the edge when off the panel); all panels at one scale");
   }
   return html + "</div>\n";
 }

@@ -19,6 +19,7 @@ struct LegendEntry {
   std::string name;
   int colour;
   bool line = false;  // a line sample instead of a dot
+  bool open = false;  // an open circle (a nominal position) instead of a filled dot
 };
 
 double legend_width(const std::vector<LegendEntry>& legend) {
@@ -77,6 +78,9 @@ class Frame {
       if (legend[k].line) {
         svg_ += "<line x1=\"" + num(lx) + "\" x2=\"" + num(lx + 10) + "\" y1=\"" + num(ly) + "\" y2=\"" + num(ly) +
                 "\" stroke=\"" + colour + "\" stroke-width=\"2\"/>";
+      } else if (legend[k].open) {
+        svg_ += "<circle cx=\"" + num(lx + 5) + "\" cy=\"" + num(ly) + "\" r=\"3.5\" fill=\"none\" stroke=\"" + colour +
+                "\" stroke-width=\"1.5\"/>";
       } else {
         svg_ += "<circle cx=\"" + num(lx + 5) + "\" cy=\"" + num(ly) + "\" r=\"3\" fill=\"" + colour + "\"/>";
       }
@@ -212,8 +216,9 @@ std::string svg_anchor_top_view(const AnchorTopView& a, double half_width_m) {
   const Ticks t = nice_ticks(-half_width_m * unit, half_width_m * unit, 4);
   PlotSpec spec{a.name + " (top view)", format("x - fitted [%s]", mm ? "mm" : "m"),
                 format("y - fitted [%s]", mm ? "mm" : "m"), t, t, 250, 0};
-  std::vector<LegendEntry> legend{{"fitted", a.colour}, {"1, 3 sigma", a.colour, true}, {"nominal", kNeutralColour}};
-  if (a.truth) legend.push_back({"true", kLoadCellColour});
+  std::vector<LegendEntry> legend{
+      {"fitted", a.colour}, {"1, 3 sigma", a.colour, true}, {"nominal", kNeutralColour, false, true}};
+  if (a.truth) legend.push_back({"true", kLoadCellColour, false, true});
   square_data_area(spec, legend, 180);
   Frame frame(spec, t, t, legend);
   const auto point = [&](const Eigen::Vector2d& world) -> Eigen::Vector2d { return (world - a.fitted) * unit; };
@@ -265,7 +270,9 @@ std::string svg_anchor_layout(const std::vector<AnchorTopView>& anchors) {
   const Ticks t = nice_ticks(lo, hi, 5);
   std::vector<LegendEntry> legend;
   for (const AnchorTopView& a : anchors) legend.push_back({a.name, a.colour});
-  legend.push_back({"open: nominal", kNeutralColour});
+  // The symbols in the anchors' colours: filled where the fit put them, open at robot.toml's nominal.
+  legend.push_back({"fitted", kNeutralColour});
+  legend.push_back({"nominal", kNeutralColour, false, true});
   PlotSpec spec{"anchors seen from above", "x [m]", "y [m]", t, t, 0, 0};
   square_data_area(spec, legend, 220);
   Frame frame(spec, t, t, legend);

@@ -167,6 +167,21 @@ StoreResult<std::vector<int>> RunHistory::prune(std::uintmax_t budget_bytes,
   return removed;
 }
 
+std::optional<RunEntry> RunHistory::find(int run) const {
+  if (run == 0) {
+    const auto found = runs();
+    if (!found || found->empty()) return std::nullopt;
+    run = found->back();
+  }
+  if (!exists(run)) return std::nullopt;
+  return read_entry(run);
+}
+
+bool RunHistory::exists(int run) const {
+  std::error_code error;
+  return run > 0 && std::filesystem::is_directory(entry_path(run), error);
+}
+
 std::optional<RunEntry> RunHistory::find_by_calibration(const std::string& calibration_text) const {
   const auto found = runs();
   if (!found) return std::nullopt;

@@ -81,6 +81,12 @@ class RunHistory {
   [[nodiscard]] StoreResult<std::vector<int>> prune(std::uintmax_t budget_bytes,
                                                     const std::vector<std::string>& protected_calibrations) const;
 
+  // Entry `run` (its run.toml parsed; not valid when unreadable), or the
+  // newest for run 0; none when there is no such entry.
+  std::optional<RunEntry> find(int run) const;
+  // Whether entry `run` is there (a run pruned meanwhile is not).
+  bool exists(int run) const;
+
   // The newest entry whose calibration.toml is exactly `calibration_text`.
   std::optional<RunEntry> find_by_calibration(const std::string& calibration_text) const;
 

@@ -1,7 +1,7 @@
 // calibctl: the operator's client of cdpr-calibd's control socket. Starts and
 // aborts a field calibration, shows its progress, the current calibration,
-// the stored versions, rolls back to one of them, and retries a commit that
-// failed.
+// the stored versions, rolls back to one of them, retries a commit that
+// failed, and commits a kept run refitted with an extra model term.
 //
 // Exit status: 0 done; 1 the daemon refused the request (or, with
 // status --follow, the run failed); 2 no daemon, or a broken connection.
@@ -34,6 +34,8 @@ struct Options {
   int interval_ms = 500;
   int seq = 0;
   bool report_path = false;
+  std::string with_term;  // commit --with-term
+  std::string run;        // its run: 7 or run-000007; empty: the newest
 };
 
 // A failure: on stderr for the operator and, with --json, on stdout as one
@@ -70,6 +72,27 @@ std::optional<JsonValue> ask(ControlClient& client, const std::string& request, 
     return std::nullopt;
   }
   return value;
+}
+
+// After `refit`: polls status until the refit has ended, prints its outcome;
+// exit 1 unless it was committed.
+int wait_for_refit(ControlClient& client, const Options& options) {
+  int exit_code = 0;
+  for (;;) {
+    std::string raw;
+    const auto status = ask(client, "status", options.json, exit_code, raw);
+    if (!status) return exit_code;
+    const JsonValue refit = (*status)["refit"];
+    if (refit.is_null() || refit["state"].string() != "running") {
+      if (options.json) {
+        std::printf("%s\n", raw.c_str());
+      } else {
+        std::printf("%s", cdpr::calibctl::render_refit(refit).c_str());
+      }
+      return !refit.is_null() && refit["state"].string() == "committed" ? 0 : kExitRefused;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(options.interval_ms));
+  }
 }
 
 // Polls status until the run is over; prints a line whenever it changes.
@@ -119,8 +142,16 @@ int main(int argc, char** argv) {
   show->add_flag("--report", options.report_path,
                  "print only the path of its report.html (in its run's history entry); exit 1 when it has none");
   app.add_subcommand("history", "the stored calibrations, newest first (* = current)");
-  app.add_subcommand("commit",
-                     "commit the calibration a failed commit kept in <state>/pending, once its cause is fixed");
+  auto* commit = app.add_subcommand(
+      "commit",
+      "commit the calibration a failed commit kept in <state>/pending, once its cause is fixed; with --with-term: "
+      "refit a kept run's samples with the catenary plus model terms and commit that fit when it validates");
+  commit->add_option("--with-term", options.with_term,
+                     "model terms to add to the catenary, comma-separated (e.g. load_cell_bias, as the model check "
+                     "of the run names them); waits for the refit and prints its outcome (exit 1 unless committed)");
+  commit->add_option("run", options.run, "with --with-term: the run to refit (7 or run-000007; default: the newest)");
+  commit->add_option("--interval", options.interval_ms, "poll interval while waiting for the refit [ms]")
+      ->check(CLI::Range(50, 60'000))->capture_default_str();
   app.add_subcommand("reset-faults", "clear the devices' latched faults once their cause is fixed (not during a run)");
   auto* rollback = app.add_subcommand("rollback", "make stored calibration SEQ current again");
   rollback->add_option("seq", options.seq, "sequence number (see history)")->required()->check(CLI::PositiveNumber);
@@ -133,13 +164,23 @@ int main(int argc, char** argv) {
     report_failure(options.json, error);
     return kExitNoDaemon;
   }
-  const std::string request = command == "rollback" ? "rollback " + std::to_string(options.seq) : command;
+  if (command == "commit" && options.with_term.empty() && !options.run.empty()) {
+    report_failure(options.json, "commit RUN needs --with-term NAME (a run is only refitted with a term)");
+    return kExitRefused;
+  }
+  const bool refit = command == "commit" && !options.with_term.empty();
+  std::string request = command == "rollback" ? "rollback " + std::to_string(options.seq) : command;
+  if (refit) request = "refit " + options.with_term + (options.run.empty() ? "" : " " + options.run);
   int exit_code = 0;
   if (command == "status" && options.follow) return follow(client, options);
   std::string raw;
   const auto response = ask(client, request, options.json, exit_code, raw);
   if (!response) return exit_code;
   using namespace cdpr::calibctl;
+  if (refit) {
+    if (!options.json) std::printf("%s\n", (*response)["message"].string().c_str());
+    return wait_for_refit(client, options);
+  }
   if (options.json) {
     std::printf("%s\n", raw.c_str());
   } else if (command == "status") {

@@ -21,7 +21,28 @@ double at(const JsonValue& vector, std::size_t k) {
   return k < elements.size() ? elements[k].number() : 0.0;
 }
 
+// The command that commits a run refitted with the terms its model check
+// named, when it named any: the operator's explicit choice.
+void append_refit_hint(std::string& out, const JsonValue& run) {
+  std::string terms;
+  for (const JsonValue& term : run["named_terms"].array()) terms += (terms.empty() ? "" : ",") + term.string();
+  if (terms.empty()) return;
+  const std::string entry = run["entry"].string();
+  const std::string name = entry.substr(entry.find_last_of('/') + 1);
+  out += "  to commit a calibration with " + terms + ": calibctl commit --with-term " + terms +
+         (name.empty() ? "" : " " + name) + "\n";
+}
+
 }  // namespace
+
+std::string render_refit(const JsonValue& refit) {
+  if (refit.is_null()) return "no refit was requested\n";
+  std::string out = format("refit of %s with %s: %s: %s\n", refit["run"].string().c_str(),
+                           refit["terms"].string().c_str(), refit["state"].string().c_str(),
+                           refit["message"].string().c_str());
+  if (!refit["entry"].string().empty()) out += "  kept in " + refit["entry"].string() + " (with its report.html)\n";
+  return out;
+}
 
 std::string render_status(const JsonValue& s) {
   std::string out = format("%s", s["state"].string().c_str());
@@ -47,7 +68,9 @@ std::string render_status(const JsonValue& s) {
     out += format("  run: %s, %d samples, data in %s\n", run["outcome"].string().c_str(), run["samples"].integer(),
                   entry.empty() ? "(not kept)" : entry.c_str());
     append_if(out, "model check", run["diagnosis"]);
+    append_refit_hint(out, run);
   }
+  if (const JsonValue refit = s["refit"]; !refit.is_null()) out += "  " + render_refit(refit);
   return out;
 }
 
@@ -92,10 +115,11 @@ std::string render_show(const JsonValue& s) {
     }
   }
   if (const JsonValue run = s["run"]; !run.is_null()) {
-    out += format("run: %s, %d samples, %d skipped, robot time %.1f s, data in %s\n", run["outcome"].string().c_str(),
+    out += format("run: %s, %d samples, %d skipped, run time %.1f s (daemon clock), data in %s\n", run["outcome"].string().c_str(),
                   run["samples"].integer(), run["skipped"].integer(), run["robot_time_s"].number(),
                   run["entry"].string().c_str());
     if (!run["diagnosis"].string().empty()) out += "model check: " + run["diagnosis"].string() + "\n";
+    append_refit_hint(out, run);
     if (!run["report"].is_null()) out += "report: " + run["report"].string() + "\n";
   }
   return out;

@@ -16,6 +16,10 @@ std::string render_progress(const JsonValue& status);
 // The current calibration: one line per winch with anchor, offset and sigmas,
 // the fit, then the model warning and the rejected readings when there are any.
 std::string render_show(const JsonValue& show);
+// The outcome of the last refit (status "refit"): "refit of run-000007 with
+// load_cell_bias: committed: committed calibration 5: ..." plus its entry.
+std::string render_refit(const JsonValue& refit);
+
 // The stored versions, newest first, the current one marked.
 std::string render_history(const JsonValue& history);
 

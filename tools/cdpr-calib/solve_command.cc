@@ -19,12 +19,10 @@ bool write_report(const SolveArgs& args, const CalibrationInputs& inputs, const 
   const std::filesystem::path dir(args.report_dir);
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
-  const HeldOutEvaluation residuals = report::fitted_residuals(inputs.robot, inputs.samples, options, result);
-  report::CalibrationReport report{"Calibration of robot " + inputs.robot.name, &inputs.robot, &result, &residuals,
-                                   truth, {{"data", args.robot_path + (args.samples_path.empty() ? "" : ", " +
-                                                                       args.samples_path)}}};
   std::ofstream out(dir / "report.html", std::ios::trunc);
-  out << report::calibration_report_html(report);
+  out << report::fitted_calibration_report_html(
+      inputs.robot, inputs.samples, options, result, truth,
+      {{"data", args.robot_path + (args.samples_path.empty() ? "" : ", " + args.samples_path)}});
   out.close();
   if (ec || !out) {
     std::fprintf(stderr, "cdpr-calib: cannot write %s\n", (dir / "report.html").c_str());

@@ -38,5 +38,21 @@ TEST(ModelCheckVerdict, SaysWhenStructureRemainsOrTheModelExplainsTheData) {
   EXPECT_EQ(model_check_verdict(failed), "model check could not run: too few samples");
 }
 
+TEST(ModelCheckVerdict, TheTermsItNamesAreReadBackFromItsText) {
+  // GIVEN verdicts naming two effects (structure remaining), one, and none
+  Diagnosis two = finished({Effect::kLoadCellBias, Effect::kElasticity}, true);
+  two.final_fit.calibration.effects["force_bias"] = {12.1};
+  two.final_fit.calibration.effects["force_bias_sigma"] = {0.8};
+  two.final_fit.calibration.effects["axial_stiffness"] = {1.5e6};
+  Diagnosis failed;
+  failed.message = "load_cell_bias: cannot fit";
+  // WHEN their terms are read back THEN exactly the named effects come out, in order
+  EXPECT_EQ(model_check_terms(model_check_verdict(two)), (std::vector<std::string>{"load_cell_bias", "elasticity"}));
+  EXPECT_TRUE(model_check_terms(model_check_verdict(finished({}, true))).empty());
+  EXPECT_TRUE(model_check_terms(model_check_verdict(finished({}, false))).empty());
+  EXPECT_TRUE(model_check_terms(model_check_verdict(failed)).empty());
+  EXPECT_TRUE(model_check_terms("").empty());
+}
+
 }  // namespace
 }  // namespace cdpr::calibration

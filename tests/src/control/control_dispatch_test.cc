@@ -26,7 +26,50 @@ TEST(ControlDispatch, StatusOfAnIdleDaemon) {
             "{\"ok\":true,\"state\":\"idle\",\"running\":false,\"waypoint\":0,\"waypoints\":0,\"samples\":0,"
             "\"skipped\":0,\"progress\":0,\"elapsed_s\":null,\"reason\":\"\",\"note\":\"\",\"detail\":\"\","
             "\"device_faults\":\"\",\"committed_seq\":0,\"interrupted\":\"\",\"store_problems\":[],\"pending_commit\":false,"
-            "\"run\":null}\n");
+            "\"run\":null,\"refit\":null}\n");
+}
+
+// A refit service that records what it was asked and answers as told.
+class FakeRefits : public RefitService {
+ public:
+  Expected<std::string, std::string> start_refit(int run, const std::string& terms) override {
+    asked.push_back(std::to_string(run) + " " + terms);
+    if (!refusal.empty()) return Unexpected{refusal};
+    status = RefitStatus{"run-000003", terms, "running", "fitting", 0, ""};
+    return std::string("refitting run-000003 with catenary + " + terms);
+  }
+  std::optional<RefitStatus> refit_status() const override { return status; }
+  std::vector<std::string> asked;
+  std::string refusal;
+  std::optional<RefitStatus> status;
+};
+
+TEST(ControlDispatch, RefitIsHandedToTheServiceAndRefusedWhileRunning) {
+  // GIVEN an idle daemon with a refit service
+  CalibrationRig rig;
+  FakeRefits refits;
+  const auto ask_refits = [&](const std::string& line) {
+    return respond(line, *rig.machine, rig.store, rig.clock.now_us(), &refits);
+  };
+  // WHEN a refit is requested THEN the service gets the run and the terms, and status shows its progress
+  EXPECT_EQ(ask_refits("refit load_cell_bias run-000003"),
+            "{\"ok\":true,\"message\":\"refitting run-000003 with catenary + load_cell_bias\"}\n");
+  EXPECT_EQ(refits.asked, (std::vector<std::string>{"3 load_cell_bias"}));
+  EXPECT_TRUE(contains(ask_refits("status"),
+                       "\"refit\":{\"run\":\"run-000003\",\"terms\":\"load_cell_bias\",\"state\":\"running\","
+                       "\"message\":\"fitting\",\"committed_seq\":0,\"entry\":\"\"}}"))
+      << ask_refits("status");
+  // WHEN the service refuses THEN the answer says why
+  refits.refusal = "unknown term 'bias'";
+  EXPECT_EQ(ask_refits("refit bias"), "{\"ok\":false,\"error\":\"refit refused: unknown term 'bias'\"}\n");
+  // WHEN no service is there THEN refit is refused
+  EXPECT_TRUE(contains(ask(rig, "refit load_cell_bias"), "refit refused: this daemon cannot refit runs"));
+  // WHEN a calibration is running THEN refit is refused before the service is asked
+  refits.refusal.clear();
+  ASSERT_EQ(ask(rig, "start"), "{\"ok\":true,\"message\":\"started\"}\n");
+  ASSERT_TRUE(rig.run_to(calibration::CalibrationState::kMove, 1));
+  EXPECT_TRUE(contains(ask_refits("refit load_cell_bias"), "refit refused: a calibration is running"));
+  EXPECT_EQ(refits.asked.size(), 2u);
 }
 
 TEST(ControlDispatch, ResetFaultsReachesTheWinchBank) {

@@ -21,11 +21,31 @@ TEST(ControlRequest, EveryCommandParses) {
   EXPECT_EQ(rollback->seq, 42);
 }
 
+TEST(ControlRequest, RefitNamesItsTermsAndOptionallyItsRun) {
+  // GIVEN refit requests with and without a run, in both spellings
+  const auto newest = parse_request("refit load_cell_bias");
+  const auto numbered = parse_request("refit elasticity,load_cell_bias 7\n");
+  const auto named = parse_request("refit  load_cell_bias\trun-000012");
+  // THEN the terms are passed on as given and the run as its number (0: the newest)
+  ASSERT_TRUE(newest && numbered && named);
+  EXPECT_EQ(newest->kind, RequestKind::kRefit);
+  EXPECT_EQ(newest->terms, "load_cell_bias");
+  EXPECT_EQ(newest->run, 0);
+  EXPECT_EQ(numbered->terms, "elasticity,load_cell_bias");
+  EXPECT_EQ(numbered->run, 7);
+  EXPECT_EQ(named->run, 12);
+  // AND a missing term, a bad run or too many words are refused with the reason
+  EXPECT_EQ(parse_request("refit").error(), "refit takes one or two arguments: <terms> [<run>]");
+  EXPECT_EQ(parse_request("refit a 3 4").error(), "refit takes one or two arguments: <terms> [<run>]");
+  EXPECT_EQ(parse_request("refit load_cell_bias 0").error(), "run '0' is not a run number (7 or run-000007)");
+  EXPECT_EQ(parse_request("refit load_cell_bias run-x").error(), "run 'run-x' is not a run number (7 or run-000007)");
+}
+
 TEST(ControlRequest, MistakesAreRefusedWithAReason) {
   // GIVEN malformed requests WHEN parsed THEN each error says what is wrong
   EXPECT_EQ(parse_request("strat").error(),
             "unknown command 'strat' (expected start, abort, status, show, history, rollback <seq>, "
-            "commit or reset-faults)");
+            "commit, reset-faults or refit <terms> [<run>])");
   EXPECT_EQ(parse_request("").error().substr(0, 13), "empty request");
   EXPECT_EQ(parse_request("START").error().substr(0, 15), "unknown command");
   EXPECT_EQ(parse_request("start now").error(), "start takes no argument");

@@ -102,7 +102,7 @@ TEST(RunRecorder, ACommittedRunKeepsItsSamplesRobotLogAndFit) {
   };
   const std::string samples_text = std::to_string(r.rig.status().samples);
   EXPECT_TRUE(contains(ask("status"), "\"run\":{\"entry\":\"" + entry + "\",\"outcome\":\"committed\",\"samples\":" +
-                                          samples_text + ",\"diagnosis\":\"\"}"))
+                                          samples_text + ",\"diagnosis\":\"\",\"named_terms\":[]}"))
       << ask("status");
   EXPECT_TRUE(contains(ask("show"), "\"run\":{\"entry\":\"" + entry + "\",\"outcome\":\"committed\",\"samples\":" +
                                         samples_text + ",\"skipped\":0,"))
@@ -172,7 +172,7 @@ TEST(RunRecorder, ACommittedRunGetsItsReportBesideTheFit) {
   const auto report = store::read_file(r.entry(1) + "/report.html");
   ASSERT_TRUE(report) << joined(r.messages);
   EXPECT_TRUE(contains(*report, "<!DOCTYPE html>")) << report->substr(0, 200);
-  EXPECT_TRUE(contains(*report, "robot time"));
+  EXPECT_TRUE(contains(*report, "run time"));
   EXPECT_TRUE(contains(*report, "run-000001, committed"));
   // AND WHEN a run is aborted before its fit THEN its entry has no report
   r.rig.button.press();
