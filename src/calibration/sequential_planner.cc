@@ -25,17 +25,24 @@ bool identifiable(const Robot& robot, const std::vector<Pose>& poses) {
   return values.maxCoeff() > 0.0 && values.minCoeff() >= kIdentifiableConditioning * values.maxCoeff();
 }
 
+// Progress is counted down to half the target sigma, not to the target: the
+// straight-cable information predicts a pose's variance reduction more
+// optimistically than the re-solved fit then shows, and with the floor at the
+// target itself most candidates saturate, the time term then picks short hops
+// that gain little, and a looser target took more waypoints than a tight one.
+constexpr double kProgressFloor = 0.25;  // of target^2
+
 // Progress towards the targets that `after` makes from `before` (the
-// diagonal of covariances): per parameter, log(max(before, t^2) / max(after,
-// t^2)). The stop needs every parameter below its target, so halving one
-// variance counts the same however far above its target it still is; a
-// variance already below its target is worth nothing more. Targets of zero:
-// the plain trace reduction.
+// diagonal of covariances): per parameter, log(max(before, f t^2) /
+// max(after, f t^2)), f = kProgressFloor. The stop needs every parameter
+// below its target, so halving one variance counts the same however far
+// above its target it still is. Targets of zero: the plain trace reduction.
 double gain(const DesignVector& before, const DesignVector& after, const DesignVector& target_sq) {
   if (target_sq.isZero()) return before.sum() - after.sum();
   double sum = 0.0;
   for (int j = 0; j < kDesignParameters; ++j) {
-    sum += std::log(std::max(before(j), target_sq(j)) / std::max(after(j), target_sq(j)));
+    const double floor = kProgressFloor * target_sq(j);
+    sum += std::log(std::max(before(j), floor) / std::max(after(j), floor));
   }
   return sum;
 }

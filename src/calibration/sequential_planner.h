@@ -14,11 +14,11 @@
 //    samples (kMaxCount), or when no candidate is left (kNoCandidates).
 // 4. Otherwise go to the candidate with the largest expected gain per unit
 //    of robot time. Gain: the relative progress of every variance towards
-//    its target that the pose would make,
-//        sum_j log(max(P_jj, t_j^2) / max(S_jj, t_j^2)),   S = (P^-1 + I_k)^-1,
+//    a quarter of its target variance that the pose would make,
+//        sum_j log(max(P_jj, t_j^2 / 4) / max(S_jj, t_j^2 / 4)),   S = (P^-1 + I_k)^-1,
 //    P the fit's covariance, I_k the pose's information at the current
 //    estimate (solver/calibration/pose_design.h) scaled to the rows' own
-//    noise; variance already below its target is worth nothing more.
+//    noise.
 //    Time: travel from the current waypoint at the winch speed
 //    (waypoint_tour.h) plus the expected settle time, plus a horizon
 //    (SequentialOptions::score_horizon_s).
