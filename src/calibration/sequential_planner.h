@@ -54,7 +54,7 @@ struct SequentialOptions {
   // horizon, time decides between candidates of similar gain (fewer
   // waypoints, less robot time in the replay: docs/calibration.md).
   // 0: the plain gain per second.
-  double score_horizon_s = 120.0;
+  double score_horizon_s = 30.0;
   CalibrationOptions solver;            // of each re-solve
 };
 

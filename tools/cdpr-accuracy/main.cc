@@ -130,6 +130,9 @@ int main(int argc, char** argv) {
   app.add_option("--settle", replay_case.sequential.settle_s,
                  "robot-time model: wait for rest plus the rest window, per waypoint [s]")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--score-horizon", replay_case.sequential.score_horizon_s,
+                 "sequential: time added to each candidate's move and settle in its score [s]")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--row-noise-scale", replay_case.noise_scale,
                  "replay: a sample row's noise as a fraction of one reading's (the daemon averages a rest window of "
                  "about 100 readings)")
