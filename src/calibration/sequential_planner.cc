@@ -25,13 +25,24 @@ bool identifiable(const Robot& robot, const std::vector<Pose>& poses) {
   return values.maxCoeff() > 0.0 && values.minCoeff() >= kIdentifiableConditioning * values.maxCoeff();
 }
 
-// Variance [target^2] above the targets that `after` leaves of `before`
-// (the diagonal of covariances); targets of zero: the plain trace reduction.
+// Progress is counted down to half the target sigma, not to the target: the
+// straight-cable information predicts a pose's variance reduction more
+// optimistically than the re-solved fit then shows, and with the floor at the
+// target itself most candidates saturate, the time term then picks short hops
+// that gain little, and a looser target took more waypoints than a tight one.
+constexpr double kProgressFloor = 0.25;  // of target^2
+
+// Progress towards the targets that `after` makes from `before` (the
+// diagonal of covariances): per parameter, log(max(before, f t^2) /
+// max(after, f t^2)), f = kProgressFloor. The stop needs every parameter
+// below its target, so halving one variance counts the same however far
+// above its target it still is. Targets of zero: the plain trace reduction.
 double gain(const DesignVector& before, const DesignVector& after, const DesignVector& target_sq) {
+  if (target_sq.isZero()) return before.sum() - after.sum();
   double sum = 0.0;
   for (int j = 0; j < kDesignParameters; ++j) {
-    const double scale = target_sq(j) > 0.0 ? target_sq(j) : 1.0;
-    sum += (std::max(before(j) - target_sq(j), 0.0) - std::max(after(j) - target_sq(j), 0.0)) / scale;
+    const double floor = kProgressFloor * target_sq(j);
+    sum += std::log(std::max(before(j), floor) / std::max(after(j), floor));
   }
   return sum;
 }
@@ -198,7 +209,8 @@ std::optional<int> SequentialPlanner::best_candidate() const {
       if (used_[k]) continue;
       const DesignInformation posterior = prior + pose_information(design, candidates_[k].rest.world_T_platform);
       const DesignVector after = posterior.ldlt().solve(DesignInformation::Identity()).diagonal();
-      const double score = gain(before, after, targets) / move_time_s(static_cast<int>(k));
+      const double score =
+          gain(before, after, targets) / (move_time_s(static_cast<int>(k)) + options_.score_horizon_s);
       if (score > best_score) {
         best = static_cast<int>(k);
         best_score = score;

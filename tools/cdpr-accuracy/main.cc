@@ -1,5 +1,6 @@
 // cdpr-accuracy: calibration accuracy over many simulated data sets, and the
 // paper's Table I model check against the simulator's equilibrium.
+#include <cmath>
 #include <cstdio>
 
 #include <CLI/CLI.hpp>
@@ -24,11 +25,13 @@ int run_replay(const cdpr::accuracy::ReplayCase& c, const std::string& preset_na
     const auto& r = runs.back();
     if (verbose) {
       std::printf("seed %3llu %s time %6.1f min waypoints %2d skipped %d travel %7.1f m (nearest neighbour alone "
-                  "%7.1f m) anchor mean %.4f worst %.4f m offset %.4f m largest sigma anchor %.4f offset %.4f m%s%s "
-                  "%s\n",
+                  "%7.1f m) anchor mean %.4f worst %.4f m offset %.4f m largest sigma anchor %.4f offset %.4f m "
+                  "error/sigma RMS %.2f%s%s %s\n",
                   static_cast<unsigned long long>(r.seed), r.ok ? "ok    " : "FAILED", r.robot_time_s / 60.0,
                   r.waypoints, r.skipped, r.travel_m, r.travel_nn_m, r.anchor_error_m, r.worst_anchor_error_m,
-                  r.offset_error_m, r.largest_anchor_sigma_m, r.largest_offset_sigma_m, r.stop.empty() ? "" : " stop: ",
+                  r.offset_error_m, r.largest_anchor_sigma_m, r.largest_offset_sigma_m,
+                  r.normalised_count ? std::sqrt(r.normalised_sq_sum / r.normalised_count) : 0.0,
+                  r.stop.empty() ? "" : " stop: ",
                   r.stop.c_str(), r.ok ? "" : r.message.c_str());
     } else {
       std::fprintf(stderr, "\r%s: run %d/%d", strategy.c_str(), s + 1, seeds);
@@ -127,9 +130,17 @@ int main(int argc, char** argv) {
   app.add_option("--settle", replay_case.sequential.settle_s,
                  "robot-time model: wait for rest plus the rest window, per waypoint [s]")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--score-horizon", replay_case.sequential.score_horizon_s,
+                 "sequential: time added to each candidate's move and settle in its score [s]")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--row-noise-scale", replay_case.noise_scale,
-                 "replay: a sample row's noise as a fraction of one reading's (the daemon averages a rest window)")
+                 "replay: a sample row's noise as a fraction of one reading's (the daemon averages a rest window of "
+                 "about 100 readings)")
       ->check(CLI::PositiveNumber)->capture_default_str();
+  std::vector<int> candidate_grid;
+  app.add_option("--candidate-grid", candidate_grid,
+                 "sequential: candidate grid xy,z (default: the daemon's [waypoints] grid_xy, grid_z)")
+      ->delimiter(',')->expected(2)->check(CLI::PositiveNumber);
   app.add_flag("--model-check", model_check_only, "only run the Table I model check");
   app.add_flag("-v,--verbose", verbose, "one line per run");
   CLI11_PARSE(app, argc, argv);
@@ -155,6 +166,10 @@ int main(int argc, char** argv) {
                            : strategy == "informative" ? cdpr::accuracy::Strategy::kInformative
                                                        : cdpr::accuracy::Strategy::kSequential;
     replay_case.count = poses;
+    if (candidate_grid.size() == 2) {
+      replay_case.candidate_grid_xy = candidate_grid[0];
+      replay_case.candidate_grid_z = candidate_grid[1];
+    }
     replay_case.anchor_perturbation_m = perturbation >= 0 ? perturbation : 0.3;
     return run_replay(replay_case, preset_name, strategy, seeds, first_seed, verbose);
   }

@@ -27,7 +27,14 @@ class Rig {
     const Pose& planned = waypoint.rest.world_T_platform;
     const Eigen::Matrix3d rotation = planned.world_R_platform.toRotationMatrix();
     const double yaw_rad = std::atan2(rotation(1, 0), rotation(0, 0));
-    const sim::EquilibriumResult state = sim::solve_equilibrium(data_.true_robot, planned.position_world, yaw_rad);
+    sim::EquilibriumResult state = sim::solve_equilibrium(data_.true_robot, planned.position_world, yaw_rad);
+    // The heading is where the cables put the platform: when the simulator's
+    // solve (from the level rigid statics) fails at exactly the planned one,
+    // a rest a little off it counts.
+    for (const double turn_rad : {0.01, -0.01, 0.03, -0.03}) {
+      if (state) break;
+      state = sim::solve_equilibrium(data_.true_robot, planned.position_world, yaw_rad + turn_rad);
+    }
     const Pose& reached = state ? state->world_T_platform : planned;
     const double travel_m =
         calibration::winch_travel_m(data_.true_robot.robot, nominal_anchors(data_.true_robot.robot), at_, reached);
@@ -122,6 +129,16 @@ ReplayResult replay(const ReplayCase& c, std::uint64_t seed) {
   Rig rig(*data, c, seed, start);
   std::vector<Sample> samples;
   if (c.strategy == Strategy::kSequential) {
+    if (c.candidate_grid_xy > 0 || c.candidate_grid_z > 0) {
+      calibration::PlannerOptions grid = options;
+      if (c.candidate_grid_xy > 0) grid.grid_xy = c.candidate_grid_xy;
+      if (c.candidate_grid_z > 0) grid.grid_z = c.candidate_grid_z;
+      candidates = calibration::candidate_waypoints(nominal, no_offsets, grid);
+      if (!candidates.ok() || candidates.waypoints.empty()) {
+        r.message = "no candidates: " + candidates.problem;
+        return r;
+      }
+    }
     calibration::SequentialOptions sequential = c.sequential;
     sequential.solver = CalibrationOptions{};
     calibration::SequentialPlanner planner(nominal, std::move(candidates.waypoints), start, sequential);

@@ -17,7 +17,12 @@
 // preset's noise times `noise_scale`: the daemon averages a rest window into
 // a row whose noise is a fraction of one reading's (docs/calibration.md
 // "Honest sigmas"), and robot.toml's [noise] says so, as the daemon's rows'
-// own sigmas do.
+// own sigmas do. The default 0.11 is what those sigmas are on the virtual
+// robot: a 2 s window of about 100 independent readings.
+//
+// The true rest is solved at the planned position and heading; where the
+// simulator's solve fails there, within 0.03 rad of that heading (the
+// heading is where the cables put the platform, not commanded).
 
 #include <cstdint>
 #include <string>
@@ -35,7 +40,9 @@ struct ReplayCase {
   Strategy strategy = Strategy::kSequential;
   int count = 35;                       // waypoints of the fixed plans
   double anchor_perturbation_m = 0.3;   // nominal anchors off the truth by this [m]
-  double noise_scale = 0.2;
+  double noise_scale = 0.11;
+  // Sequential: its candidate grid (0: the daemon's [waypoints] grid_xy, grid_z).
+  int candidate_grid_xy = 0, candidate_grid_z = 0;
   calibration::SequentialOptions sequential;  // also the robot-time model (winch speed, settle)
 };
 
