@@ -14,6 +14,7 @@
 #include "solver/calibration/model_fit_check.h"
 #include "solver/calibration/pose_factor_rows.h"
 #include "solver/calibration/row_attribution.h"
+#include "solver/calibration/start_selection.h"
 
 namespace cdpr {
 namespace {
@@ -305,6 +306,17 @@ CalibrationResult calibrate_once(const Robot& robot, const std::vector<Sample>& 
 
 namespace {
 
+bool has_anchors(const CalibrationResult& result) {
+  return result.calibration.winches.size() == static_cast<std::size_t>(kCableCount);
+}
+
+// `robot` with the anchors of a fit as its nominal ones: a start for another fit.
+Robot started_at(const Robot& robot, const CalibrationResult& fit) {
+  Robot start = robot;
+  for (int i = 0; i < kCableCount; ++i) start.winches[i].anchor_world = fit.calibration.winches[i].anchor_world;
+  return start;
+}
+
 // The share of rows with a gross error.
 double gross_error_row_fraction(const CalibrationResult& result, std::size_t rows) {
   std::vector<int> ids;
@@ -411,26 +423,17 @@ CalibrationResult refit_without(const Robot& robot, const std::vector<Sample>& s
   // missing effect's signature, which diagnose needs, not a gross error.
   const double misfit_scale =
       refit.degrees_of_freedom > 0 ? std::max(1.0, std::sqrt(refit.chi_square / refit.degrees_of_freedom)) : 1.0;
-  std::vector<SensorReading> confirmed;
-  for (const SensorReading& r : robust.gross_errors) {
-    const auto predicted = std::find_if(
-        refit.left_out_residuals.begin(), refit.left_out_residuals.end(), [&](const SensorReading& p) {
-          return p.row == r.row && p.sensor == r.sensor && p.cable == r.cable;
-        });
-    if (!refit.ok || predicted == refit.left_out_residuals.end() ||
-        std::abs(predicted->value) > options.rejection_threshold_sigma * misfit_scale) {
-      confirmed.push_back(r);
-      // A candidate from a left-out row has no robust residual: the refit's prediction names its size.
-      if (std::isnan(r.value) && predicted != refit.left_out_residuals.end()) confirmed.back().value = predicted->value;
-    }
-  }
+  const std::vector<SensorReading> confirmed = confirm_left_out(
+      robust.gross_errors, refit.left_out_residuals, refit.ok, options.rejection_threshold_sigma * misfit_scale);
   if (confirmed.size() < robust.gross_errors.size()) {
-    for (int i = 0; i < kCableCount; ++i) restart.winches[i].anchor_world = refit.calibration.winches[i].anchor_world;
+    // A failed refit has no anchors: the robust fit's stay the start.
+    if (has_anchors(refit)) {
+      for (int i = 0; i < kCableCount; ++i) restart.winches[i].anchor_world = refit.calibration.winches[i].anchor_world;
+    }
     refit = calibrate_with_restart(restart, leave_out(samples, confirmed, options.cable_model), plain);
   }
   refit.gross_errors = confirmed;
   refit.calibration.rejected = confirmed;
-  for (int id : robust.rejected_samples) refit.rejected_samples.push_back(id);
   if (refit.ok) {
     refit.message += "; " + std::to_string(confirmed.size()) + " readings with gross errors left out";
   }
@@ -446,8 +449,7 @@ CalibrationResult refit_without(const Robot& robot, const std::vector<Sample>& s
 // threshold. Nothing when the set is large or no hypothesis brings the
 // flagged rows within the allowed fraction.
 std::optional<CalibrationResult> consensus_start(const Robot& robot, const std::vector<Sample>& samples,
-                                                 const CalibrationOptions& options,
-                                                 const CalibrationResult& robust) {
+                                                 const CalibrationOptions& options) {
   // Each hypothesis is a full robust fit: only worth it where one row is a
   // large share of the data.
   constexpr std::size_t kMaxRows = 20;
@@ -474,7 +476,6 @@ std::optional<CalibrationResult> consensus_start(const Robot& robot, const std::
   if (options.cable_model == CableModelKind::kCatenary) {
     candidate.gross_errors.push_back({id, SensorKind::kForce, robot.reference_cable, unknown});
   }
-  candidate.rejected_samples = robust.rejected_samples;
   return candidate;
 }
 
@@ -496,11 +497,16 @@ std::vector<Sample> leave_out(const std::vector<Sample>& samples, const std::vec
   return kept;
 }
 
-CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& samples, const CalibrationOptions& options) {
+namespace {
+
+// calibrate() from one start: the robust fit, the gross errors left out and
+// the fit redone, the leave-one-row-out hypotheses on small sets.
+CalibrationResult calibrate_from(const Robot& robot, const std::vector<Sample>& samples,
+                                 const CalibrationOptions& options) {
   CalibrationResult result = calibrate_with_restart(robot, samples, options);
   if (!result.ok && !result.gross_errors.empty() &&
       gross_error_row_fraction(result, samples.size()) > options.max_rejected_fraction) {
-    if (auto candidate = consensus_start(robot, samples, options, result)) result = std::move(*candidate);
+    if (auto candidate = consensus_start(robot, samples, options)) result = std::move(*candidate);
   }
   if (result.ok || result.gross_errors.empty()) {
     if (result.ok) assess_model_fit(result, options);
@@ -515,7 +521,7 @@ CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& sampl
   // leave-one-row-out hypotheses get a chance, and the fit that explains
   // its readings better (chi-square per degree of freedom) is kept.
   if (!result.misfit) return result;
-  auto candidate = consensus_start(robot, samples, options, robust);
+  auto candidate = consensus_start(robot, samples, options);
   if (!candidate) return result;
   CalibrationResult other = refit_without(robot, samples, options, *candidate);
   if (!other.ok) return result;
@@ -524,6 +530,54 @@ CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& sampl
     return r.degrees_of_freedom > 0 ? r.chi_square / r.degrees_of_freedom : std::numeric_limits<double>::infinity();
   };
   return per_dof(other) < per_dof(result) ? other : result;
+}
+
+// The anchors of a least-squares rigid fit from the nominal ones, as a start:
+// straight cables have no sag to start and reach their minimum from farther
+// away, and least squares keeps every reading in, so a start that a robust
+// fit would have bent around one good reading cannot form here.
+std::optional<Robot> rigid_start(const Robot& robot, const std::vector<Sample>& samples,
+                                 const CalibrationOptions& options) {
+  CalibrationOptions rigid = options;
+  rigid.cable_model = CableModelKind::kRigid;
+  rigid.robust = false;
+  rigid.huber_width = 0.0;
+  rigid.effects.clear();
+  rigid.progress = nullptr;
+  const CalibrationResult fit = calibrate_once(robot, samples, rigid);
+  if (!fit.ok || !has_anchors(fit)) return std::nullopt;
+  return started_at(robot, fit);
+}
+
+}  // namespace
+
+CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& samples, const CalibrationOptions& options) {
+  CalibrationResult best = calibrate_from(robot, samples, options);
+  if (!options.robust || options.cable_model != CableModelKind::kCatenary || !worth_other_starts(best)) return best;
+  // Multi-start (solver/calibration/start_selection.h): the fit's own
+  // anchors when its start could not take every row, then a rigid fit's,
+  // each of those again from its own anchors when it left rows out; the
+  // best fit of every row is kept.
+  const double threshold = options.rejection_threshold_sigma;
+  auto consider = [&](CalibrationResult other, const char* why) {
+    if (!better_fit(other, best, threshold)) return;
+    other.message += std::string(" (kept from ") + why + ": it fits the readings better than the fit from the "
+                     "nominal anchors)";
+    best = std::move(other);
+  };
+  auto with_every_row = [&](const CalibrationResult& fit, const char* why) {
+    if (fit.ok && !fit.rejected_samples.empty() && has_anchors(fit)) {
+      consider(calibrate_from(started_at(robot, fit), samples, options), why);
+    }
+  };
+  with_every_row(best, "a restart from the fit's own anchors, where every row could be started");
+  if (const std::optional<Robot> start = rigid_start(robot, samples, options)) {
+    CalibrationResult from_rigid = calibrate_from(*start, samples, options);
+    const CalibrationResult kept = from_rigid;
+    consider(std::move(from_rigid), "a start at a rigid fit's anchors");
+    with_every_row(kept, "a start at a rigid fit's anchors, then its own");
+  }
+  return best;
 }
 
 }  // namespace cdpr

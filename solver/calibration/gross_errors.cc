@@ -47,4 +47,24 @@ double largest_normalised_residual(const std::vector<ReadingResidual>& residuals
   return largest;
 }
 
+std::vector<SensorReading> confirm_left_out(const std::vector<SensorReading>& candidates,
+                                            const std::vector<SensorReading>& predicted, bool refit_ok,
+                                            double bar_sigma) {
+  std::vector<SensorReading> confirmed;
+  for (const SensorReading& r : candidates) {
+    const auto p = std::find_if(predicted.begin(), predicted.end(), [&](const SensorReading& q) {
+      return q.row == r.row && q.sensor == r.sensor && q.cable == r.cable;
+    });
+    const bool known = refit_ok && p != predicted.end() && std::isfinite(p->value);
+    if (known) {
+      if (std::abs(p->value) <= bar_sigma) continue;
+      confirmed.push_back(r);
+      if (std::isnan(r.value)) confirmed.back().value = p->value;
+    } else if (std::isfinite(r.value)) {
+      confirmed.push_back(r);
+    }
+  }
+  return confirmed;
+}
+
 }  // namespace cdpr

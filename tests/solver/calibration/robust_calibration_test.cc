@@ -124,6 +124,27 @@ TEST(RobustCalibration, OneGrossErrorThatCapturesTheRobustFitOnNinePosesIsStillF
   EXPECT_LT(mean_anchor_error(result.calibration, data.truth), 2.0);
 }
 
+TEST(RobustCalibration, AStartThatCannotTakeEveryRowStillReachesTheTruthStartedMinimum) {
+  // GIVEN 9 clean poses of the large robot with nominal anchors 20 m off,
+  // from which 3 rows cannot be started (their cable geometry is infeasible)
+  sim::DatasetConfig config = large(9, 22);
+  config.anchor_perturbation_m = 20.0;
+  const auto simulated = sim::simulate_dataset(config);
+  ASSERT_TRUE(simulated) << simulated.error();
+  const sim::SimulatedDataset& data = *simulated;
+  Robot at_truth = data.nominal;
+  for (int i = 0; i < kCableCount; ++i) at_truth.winches[i].anchor_world = data.truth.winches[i].anchor_world;
+  // WHEN calibrated from the nominal anchors and from the true ones
+  const CalibrationResult result = calibrate(data.nominal, data.samples, CalibrationOptions{});
+  const CalibrationResult reference = calibrate(at_truth, data.samples, CalibrationOptions{});
+  // THEN the multi-start fits every row and ends at the same minimum
+  ASSERT_TRUE(result.ok) << result.message;
+  ASSERT_TRUE(reference.ok) << reference.message;
+  EXPECT_EQ(result.calibration.samples, 9);
+  EXPECT_TRUE(result.rejected_samples.empty());
+  EXPECT_NEAR(result.solver.final_cost, reference.solver.final_cost, 1e-6 * reference.solver.final_cost);
+}
+
 TEST(RobustCalibration, AFitThatKeptAGrossErrorAndMisfitsIsRedoneFromTheBadRowLeftOut) {
   // GIVEN 8 poses of the small robot, nominal anchors 1 m off, a 1.75 m
   // encoder error and a load-cell spike, where the robust fit flags good
