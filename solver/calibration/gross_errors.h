@@ -50,8 +50,11 @@ double largest_normalised_residual(const std::vector<ReadingResidual>& residuals
 // refit without it predicts it (a leave-one-out residual). A reading stays
 // out when the refit predicts it beyond bar_sigma, or when the refit failed
 // or has no prediction for it and it was flagged by its own residual; it
-// then carries the prediction's size when its own was unknown. A hypothesis
-// reading nothing confirms goes back in, so no NaN is ever reported.
+// then carries the prediction's size when its own was unknown. Of a
+// hypothesis row (all its readings left out, so each is predicted from the
+// row's pose prior alone) only the reading predicted farthest off stays
+// out. A hypothesis reading nothing confirms goes back in, so no NaN is
+// ever reported.
 std::vector<SensorReading> confirm_left_out(const std::vector<SensorReading>& candidates,
                                             const std::vector<SensorReading>& predicted, bool refit_ok,
                                             double bar_sigma);

@@ -79,15 +79,18 @@ TEST(GrossErrors, AFailedRefitKeepsOnlyReadingsFlaggedByTheirOwnResidual) {
   EXPECT_DOUBLE_EQ(confirmed[0].value, -70.0);
 }
 
-TEST(GrossErrors, AHypothesisReadingTakesTheSizeOfItsPrediction) {
-  // GIVEN a row hypothesis reading that the refit predicts 25 sigma off
-  const std::vector<SensorReading> candidates{
-      {6, SensorKind::kEncoder, 1, std::numeric_limits<double>::quiet_NaN()}};
+TEST(GrossErrors, OfAHypothesisRowOnlyTheReadingPredictedFarthestOffStaysOut) {
+  // GIVEN a row hypothesis: two of its readings predicted beyond the bar
+  // (from the pose prior alone, good readings look bad too)
+  const double unknown = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<SensorReading> candidates{{6, SensorKind::kEncoder, 1, unknown},
+                                              {6, SensorKind::kForce, 0, unknown}};
   // WHEN confirmed
-  const std::vector<SensorReading> confirmed =
-      confirm_left_out(candidates, {{6, SensorKind::kEncoder, 1, 25.0}}, true, 5.0);
-  // THEN it stays out, reported with the predicted size
+  const std::vector<SensorReading> confirmed = confirm_left_out(
+      candidates, {{6, SensorKind::kEncoder, 1, 25.0}, {6, SensorKind::kForce, 0, -12.0}}, true, 5.0);
+  // THEN only the farthest stays out, reported with the predicted size
   ASSERT_EQ(confirmed.size(), 1u);
+  EXPECT_EQ(confirmed[0].sensor, SensorKind::kEncoder);
   EXPECT_DOUBLE_EQ(confirmed[0].value, 25.0);
 }
 
