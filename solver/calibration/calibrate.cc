@@ -406,19 +406,30 @@ std::string rows_text(const std::vector<SensorReading>& readings) {
 // robust fit's anchors.
 CalibrationResult refit_without(const Robot& robot, const std::vector<Sample>& samples,
                                 const CalibrationOptions& options, const CalibrationResult& robust) {
-  const double fraction = gross_error_row_fraction(robust, samples.size());
-  if (fraction > options.max_rejected_fraction) {
+  // Refused when the readings flagged (a hypothesis row's readings are not
+  // flagged, only tentative: the final test below decides them) or, after
+  // the final test, those confirmed lie on more rows than allowed.
+  auto refusal = [&](const std::vector<SensorReading>& readings) -> std::optional<CalibrationResult> {
     CalibrationResult refused = robust;
+    refused.gross_errors = readings;
+    const double fraction = gross_error_row_fraction(refused, samples.size());
+    if (fraction <= options.max_rejected_fraction) return std::nullopt;
     refused.ok = false;
+    refused.calibration.rejected.clear();
     char text[256];
     std::snprintf(text, sizeof text,
                   "%.0f of %zu rows (%.0f %%) have gross errors, more than the %.0f %% allowed: the robot or its "
                   "sensors need attention (or the model does not fit; see cdpr-calib diagnose). ",
                   std::round(fraction * static_cast<double>(samples.size())), samples.size(), 100.0 * fraction,
                   100.0 * options.max_rejected_fraction);
-    refused.message = text + rows_text(robust.gross_errors);
+    refused.message = text + rows_text(readings);
     return refused;
+  };
+  std::vector<SensorReading> flagged;
+  for (const SensorReading& r : robust.gross_errors) {
+    if (std::isfinite(r.value)) flagged.push_back(r);
   }
+  if (auto refused = refusal(flagged)) return *refused;
   const std::vector<Sample> kept = leave_out(samples, robust.gross_errors, options.cable_model);
   Robot restart = robot;
   for (int i = 0; i < kCableCount; ++i) restart.winches[i].anchor_world = robust.calibration.winches[i].anchor_world;
@@ -442,6 +453,7 @@ CalibrationResult refit_without(const Robot& robot, const std::vector<Sample>& s
     }
     refit = calibrate_with_restart(restart, leave_out(samples, confirmed, options.cable_model), plain);
   }
+  if (auto refused = refusal(confirmed)) return *refused;
   refit.gross_errors = confirmed;
   refit.calibration.rejected = confirmed;
   if (refit.ok) note_left_out(refit);

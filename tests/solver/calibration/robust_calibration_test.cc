@@ -176,6 +176,22 @@ void expect_planted_named_without_misfit(const sim::DatasetConfig& config, doubl
   EXPECT_LT(mean_anchor_error(result.calibration, simulated->truth), max_error_m);
 }
 
+TEST(RobustCalibration, ARefusalAfterARowHypothesisNamesOnlyMeasuredResiduals) {
+  // GIVEN 9 poses, nominal anchors 10 m off, 20 % rows with an encoder
+  // error and 5 % with a load-cell spike, where the leave-one-row-out
+  // hypotheses run and the run is still refused
+  sim::DatasetConfig config = large(9, 21);
+  config.gross_errors.encoder_fraction = 0.2;
+  config.gross_errors.force_fraction = 0.05;
+  const auto simulated = sim::simulate_dataset(config);
+  ASSERT_TRUE(simulated) << simulated.error();
+  // WHEN calibrated with default options
+  const CalibrationResult result = calibrate(simulated->nominal, simulated->samples, CalibrationOptions{});
+  // THEN every reading it names has a residual, in the message too
+  for (const SensorReading& r : result.gross_errors) EXPECT_TRUE(std::isfinite(r.value)) << "row " << r.row;
+  EXPECT_EQ(result.message.find("nan"), std::string::npos) << result.message;
+}
+
 TEST(RobustCalibration, AGrossErrorAbsorbedByItsRowsLoadCellIsStillNamed) {
   // GIVEN 9 poses, nominal anchors 10 m off, a 0.51 m encoder error that
   // the robust fit's leave-one-out puts on its row's load cell (whose
