@@ -14,6 +14,7 @@
 #include "solver/calibration/model_fit_check.h"
 #include "solver/calibration/pose_factor_rows.h"
 #include "solver/calibration/row_attribution.h"
+#include "solver/calibration/start_selection.h"
 
 namespace cdpr {
 namespace {
@@ -305,6 +306,27 @@ CalibrationResult calibrate_once(const Robot& robot, const std::vector<Sample>& 
 
 namespace {
 
+// Sets of at most this many rows, where one row is a large share of the
+// data, get the leave-one-row-out hypotheses and the swap test: each is a
+// handful of full fits, too many for large sets, which do not need them.
+constexpr std::size_t kSmallSetRows = 20;
+
+// "; N readings with gross errors left out" on a fit's message.
+void note_left_out(CalibrationResult& fit) {
+  fit.message += "; " + std::to_string(fit.gross_errors.size()) + " readings with gross errors left out";
+}
+
+bool has_anchors(const CalibrationResult& result) {
+  return result.calibration.winches.size() == static_cast<std::size_t>(kCableCount);
+}
+
+// `robot` with the anchors of a fit as its nominal ones: a start for another fit.
+Robot started_at(const Robot& robot, const CalibrationResult& fit) {
+  Robot start = robot;
+  for (int i = 0; i < kCableCount; ++i) start.winches[i].anchor_world = fit.calibration.winches[i].anchor_world;
+  return start;
+}
+
 // The share of rows with a gross error.
 double gross_error_row_fraction(const CalibrationResult& result, std::size_t rows) {
   std::vector<int> ids;
@@ -384,19 +406,30 @@ std::string rows_text(const std::vector<SensorReading>& readings) {
 // robust fit's anchors.
 CalibrationResult refit_without(const Robot& robot, const std::vector<Sample>& samples,
                                 const CalibrationOptions& options, const CalibrationResult& robust) {
-  const double fraction = gross_error_row_fraction(robust, samples.size());
-  if (fraction > options.max_rejected_fraction) {
+  // Refused when the readings flagged (a hypothesis row's readings are not
+  // flagged, only tentative: the final test below decides them) or, after
+  // the final test, those confirmed lie on more rows than allowed.
+  auto refusal = [&](const std::vector<SensorReading>& readings) -> std::optional<CalibrationResult> {
     CalibrationResult refused = robust;
+    refused.gross_errors = readings;
+    const double fraction = gross_error_row_fraction(refused, samples.size());
+    if (fraction <= options.max_rejected_fraction) return std::nullopt;
     refused.ok = false;
+    refused.calibration.rejected.clear();
     char text[256];
     std::snprintf(text, sizeof text,
                   "%.0f of %zu rows (%.0f %%) have gross errors, more than the %.0f %% allowed: the robot or its "
                   "sensors need attention (or the model does not fit; see cdpr-calib diagnose). ",
                   std::round(fraction * static_cast<double>(samples.size())), samples.size(), 100.0 * fraction,
                   100.0 * options.max_rejected_fraction);
-    refused.message = text + rows_text(robust.gross_errors);
+    refused.message = text + rows_text(readings);
     return refused;
+  };
+  std::vector<SensorReading> flagged;
+  for (const SensorReading& r : robust.gross_errors) {
+    if (std::isfinite(r.value)) flagged.push_back(r);
   }
+  if (auto refused = refusal(flagged)) return *refused;
   const std::vector<Sample> kept = leave_out(samples, robust.gross_errors, options.cable_model);
   Robot restart = robot;
   for (int i = 0; i < kCableCount; ++i) restart.winches[i].anchor_world = robust.calibration.winches[i].anchor_world;
@@ -411,29 +444,19 @@ CalibrationResult refit_without(const Robot& robot, const std::vector<Sample>& s
   // missing effect's signature, which diagnose needs, not a gross error.
   const double misfit_scale =
       refit.degrees_of_freedom > 0 ? std::max(1.0, std::sqrt(refit.chi_square / refit.degrees_of_freedom)) : 1.0;
-  std::vector<SensorReading> confirmed;
-  for (const SensorReading& r : robust.gross_errors) {
-    const auto predicted = std::find_if(
-        refit.left_out_residuals.begin(), refit.left_out_residuals.end(), [&](const SensorReading& p) {
-          return p.row == r.row && p.sensor == r.sensor && p.cable == r.cable;
-        });
-    if (!refit.ok || predicted == refit.left_out_residuals.end() ||
-        std::abs(predicted->value) > options.rejection_threshold_sigma * misfit_scale) {
-      confirmed.push_back(r);
-      // A candidate from a left-out row has no robust residual: the refit's prediction names its size.
-      if (std::isnan(r.value) && predicted != refit.left_out_residuals.end()) confirmed.back().value = predicted->value;
-    }
-  }
+  const std::vector<SensorReading> confirmed = confirm_left_out(
+      robust.gross_errors, refit.left_out_residuals, refit.ok, options.rejection_threshold_sigma * misfit_scale);
   if (confirmed.size() < robust.gross_errors.size()) {
-    for (int i = 0; i < kCableCount; ++i) restart.winches[i].anchor_world = refit.calibration.winches[i].anchor_world;
+    // A failed refit has no anchors: the robust fit's stay the start.
+    if (has_anchors(refit)) {
+      for (int i = 0; i < kCableCount; ++i) restart.winches[i].anchor_world = refit.calibration.winches[i].anchor_world;
+    }
     refit = calibrate_with_restart(restart, leave_out(samples, confirmed, options.cable_model), plain);
   }
+  if (auto refused = refusal(confirmed)) return *refused;
   refit.gross_errors = confirmed;
   refit.calibration.rejected = confirmed;
-  for (int id : robust.rejected_samples) refit.rejected_samples.push_back(id);
-  if (refit.ok) {
-    refit.message += "; " + std::to_string(confirmed.size()) + " readings with gross errors left out";
-  }
+  if (refit.ok) note_left_out(refit);
   return refit;
 }
 
@@ -446,12 +469,8 @@ CalibrationResult refit_without(const Robot& robot, const std::vector<Sample>& s
 // threshold. Nothing when the set is large or no hypothesis brings the
 // flagged rows within the allowed fraction.
 std::optional<CalibrationResult> consensus_start(const Robot& robot, const std::vector<Sample>& samples,
-                                                 const CalibrationOptions& options,
-                                                 const CalibrationResult& robust) {
-  // Each hypothesis is a full robust fit: only worth it where one row is a
-  // large share of the data.
-  constexpr std::size_t kMaxRows = 20;
-  if (samples.size() > kMaxRows || samples.size() < 3) return std::nullopt;
+                                                 const CalibrationOptions& options) {
+  if (samples.size() > kSmallSetRows || samples.size() < 3) return std::nullopt;
   std::optional<CalibrationResult> best;
   std::size_t best_row = 0;
   for (std::size_t k = 0; k < samples.size(); ++k) {
@@ -474,8 +493,91 @@ std::optional<CalibrationResult> consensus_start(const Robot& robot, const std::
   if (options.cable_model == CableModelKind::kCatenary) {
     candidate.gross_errors.push_back({id, SensorKind::kForce, robot.reference_cable, unknown});
   }
-  candidate.rejected_samples = robust.rejected_samples;
   return candidate;
+}
+
+// On a small set, a gross error can be absorbed and stay in while a good
+// reading is left out in its place: by its row's pose and reference force
+// once another reading of the row is left out (above all the load cell,
+// whose absence frees both force components), or by its cable's anchor and
+// offset, which then make the same cable's reading of another row look bad.
+// A row may also hold two gross errors of which one was found. So for each
+// reading left out, every other reading of its row is tried in its place
+// and beside it, the same sensor of every other row in its place, and the
+// reading itself back in; the fit is redone by least squares each time. The best
+// change is kept when a reading it newly leaves out is predicted beyond the
+// threshold and the fit explains the readings better (start_score) without
+// starting to misfit; then the search starts over, a bounded number of times.
+CalibrationResult swap_within_rows(const Robot& robot, const std::vector<Sample>& samples,
+                                   const CalibrationOptions& options, CalibrationResult result) {
+  if (samples.size() > kSmallSetRows || options.cable_model != CableModelKind::kCatenary || !result.ok) return result;
+  CalibrationOptions plain = options;
+  plain.robust = false;
+  auto same = [](const SensorReading& a, const SensorReading& b) {
+    return a.row == b.row && a.sensor == b.sensor && a.cable == b.cable;
+  };
+  auto left_out = [&](const SensorReading& in) {
+    return std::any_of(result.gross_errors.begin(), result.gross_errors.end(),
+                       [&](const SensorReading& r) { return same(r, in); });
+  };
+  // Each change of the set left out: the fit, or nothing when it is not kept.
+  auto try_change = [&](std::vector<SensorReading> changed, const SensorReading* in) -> std::optional<CalibrationResult> {
+    CalibrationResult refit =
+        calibrate_with_restart(started_at(robot, result), leave_out(samples, changed, options.cable_model), plain);
+    if (!refit.ok) return std::nullopt;
+    if (in) {
+      const auto predicted = std::find_if(refit.left_out_residuals.begin(), refit.left_out_residuals.end(),
+                                          [&](const SensorReading& p) { return same(p, *in); });
+      if (predicted == refit.left_out_residuals.end() ||
+          !(std::abs(predicted->value) > options.rejection_threshold_sigma)) {
+        return std::nullopt;
+      }
+      for (SensorReading& r : changed) {
+        if (same(r, *in)) r.value = predicted->value;
+      }
+    }
+    refit.gross_errors = changed;
+    refit.calibration.rejected = changed;
+    note_left_out(refit);
+    assess_model_fit(refit, options);
+    if (refit.misfit && !result.misfit) return std::nullopt;
+    return refit;
+  };
+  const int max_changes = 2 * static_cast<int>(result.gross_errors.size()) + 2;
+  for (int change = 0; change < max_changes; ++change) {
+    std::optional<CalibrationResult> best;
+    auto consider = [&](std::optional<CalibrationResult> fit) {
+      if (fit && better_fit(*fit, best ? *best : result, options.rejection_threshold_sigma)) best = std::move(fit);
+    };
+    for (std::size_t g = 0; g < result.gross_errors.size(); ++g) {
+      const SensorReading out = result.gross_errors[g];
+      std::vector<SensorReading> peers;
+      for (const Sample& sample : samples) {
+        if (sample.id == out.row) {
+          for (int i = 0; i < kCableCount; ++i) peers.push_back({out.row, SensorKind::kEncoder, i, 0.0});
+          peers.push_back({out.row, SensorKind::kForce, robot.reference_cable, 0.0});
+        } else {
+          peers.push_back({sample.id, out.sensor, out.cable, 0.0});
+        }
+      }
+      for (const SensorReading& in : peers) {
+        if (left_out(in)) continue;
+        std::vector<SensorReading> swapped = result.gross_errors;
+        swapped[g] = in;
+        consider(try_change(swapped, &in));
+        if (in.row != out.row) continue;
+        std::vector<SensorReading> beside = result.gross_errors;
+        beside.push_back(in);
+        consider(try_change(beside, &in));
+      }
+      std::vector<SensorReading> back = result.gross_errors;
+      back.erase(back.begin() + static_cast<std::ptrdiff_t>(g));
+      consider(try_change(back, nullptr));
+    }
+    if (!best) break;
+    result = std::move(*best);
+  }
+  return result;
 }
 
 }  // namespace
@@ -496,11 +598,20 @@ std::vector<Sample> leave_out(const std::vector<Sample>& samples, const std::vec
   return kept;
 }
 
-CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& samples, const CalibrationOptions& options) {
+namespace {
+
+// calibrate() from one start: the robust fit, the gross errors left out and
+// the fit redone, the leave-one-row-out hypotheses on small sets.
+CalibrationResult calibrate_from(const Robot& robot, const std::vector<Sample>& samples,
+                                 const CalibrationOptions& options) {
   CalibrationResult result = calibrate_with_restart(robot, samples, options);
+  bool hypothesis = false;
   if (!result.ok && !result.gross_errors.empty() &&
       gross_error_row_fraction(result, samples.size()) > options.max_rejected_fraction) {
-    if (auto candidate = consensus_start(robot, samples, options, result)) result = std::move(*candidate);
+    if (auto candidate = consensus_start(robot, samples, options)) {
+      result = std::move(*candidate);
+      hypothesis = true;
+    }
   }
   if (result.ok || result.gross_errors.empty()) {
     if (result.ok) assess_model_fit(result, options);
@@ -510,20 +621,84 @@ CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& sampl
   result = refit_without(robot, samples, options, robust);
   if (!result.ok) return result;
   assess_model_fit(result, options);
-  // A fit that left gross errors out and still misfits may sit where one
-  // bad reading of a small set led it (and left that reading in): the
-  // leave-one-row-out hypotheses get a chance, and the fit that explains
-  // its readings better (chi-square per degree of freedom) is kept.
-  if (!result.misfit) return result;
-  auto candidate = consensus_start(robot, samples, options, robust);
-  if (!candidate) return result;
-  CalibrationResult other = refit_without(robot, samples, options, *candidate);
-  if (!other.ok) return result;
-  assess_model_fit(other, options);
-  auto per_dof = [](const CalibrationResult& r) {
-    return r.degrees_of_freedom > 0 ? r.chi_square / r.degrees_of_freedom : std::numeric_limits<double>::infinity();
+  if (hypothesis) return result;
+  // On a small set, one gross error can be absorbed by its cable's anchor
+  // and offset and stay in, while good readings are left out in its place,
+  // and the fit may still pass the model-fit test. The leave-one-row-out
+  // hypotheses get a chance: a fit that passes is replaced by the
+  // hypothesis' fit when that explains the readings better (start_score,
+  // solver/calibration/start_selection.h); a fit that misfits, by the one
+  // with the smaller chi-square per degree of freedom (a genuine model
+  // misfit stays flagged).
+  if (auto candidate = consensus_start(robot, samples, options)) {
+    CalibrationResult other = refit_without(robot, samples, options, *candidate);
+    if (other.ok) {
+      assess_model_fit(other, options);
+      auto per_dof = [](const CalibrationResult& r) {
+        return r.degrees_of_freedom > 0 ? r.chi_square / r.degrees_of_freedom
+                                        : std::numeric_limits<double>::infinity();
+      };
+      const bool take = result.misfit ? per_dof(other) < per_dof(result)
+                                      : !other.misfit && better_fit(other, result, options.rejection_threshold_sigma);
+      if (take) result = std::move(other);
+    }
+  }
+  return result;
+}
+
+// The anchors of a least-squares rigid fit from the nominal ones, as a start:
+// straight cables have no sag to start and reach their minimum from farther
+// away, and least squares keeps every reading in, so a start that a robust
+// fit would have bent around one good reading cannot form here.
+std::optional<Robot> rigid_start(const Robot& robot, const std::vector<Sample>& samples,
+                                 const CalibrationOptions& options) {
+  CalibrationOptions rigid = options;
+  rigid.cable_model = CableModelKind::kRigid;
+  rigid.robust = false;
+  rigid.huber_width = 0.0;
+  rigid.effects.clear();
+  rigid.progress = nullptr;
+  const CalibrationResult fit = calibrate_once(robot, samples, rigid);
+  if (!fit.ok || !has_anchors(fit)) return std::nullopt;
+  return started_at(robot, fit);
+}
+
+
+// Multi-start (solver/calibration/start_selection.h): the fit's own anchors
+// when its start could not take every row, then a rigid fit's, each of those
+// again from its own anchors when it left rows out; the best fit is kept.
+CalibrationResult best_of_starts(const Robot& robot, const std::vector<Sample>& samples,
+                                 const CalibrationOptions& options, CalibrationResult best) {
+  const double threshold = options.rejection_threshold_sigma;
+  auto consider = [&](CalibrationResult other, const char* why) {
+    if (!better_fit(other, best, threshold)) return;
+    other.message += std::string(" (kept from ") + why + ": it fits the readings better than the fit from the "
+                     "nominal anchors)";
+    best = std::move(other);
   };
-  return per_dof(other) < per_dof(result) ? other : result;
+  auto with_every_row = [&](const CalibrationResult& fit, const char* why) {
+    if (fit.ok && !fit.rejected_samples.empty() && has_anchors(fit)) {
+      consider(calibrate_from(started_at(robot, fit), samples, options), why);
+    }
+  };
+  with_every_row(best, "a restart from the fit's own anchors, where every row could be started");
+  if (const std::optional<Robot> start = rigid_start(robot, samples, options)) {
+    CalibrationResult from_rigid = calibrate_from(*start, samples, options);
+    const CalibrationResult kept = from_rigid;
+    consider(std::move(from_rigid), "a start at a rigid fit's anchors");
+    with_every_row(kept, "a start at a rigid fit's anchors, then its own");
+  }
+  return best;
+}
+
+}  // namespace
+
+CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& samples, const CalibrationOptions& options) {
+  CalibrationResult first = calibrate_from(robot, samples, options);
+  if (!options.robust || options.cable_model != CableModelKind::kCatenary || !worth_other_starts(first)) return first;
+  // The set the kept fit left out gets its swap test once, at the end.
+  return swap_within_rows(robot, samples, options, best_of_starts(robot, samples, options, std::move(first)));
 }
 
 }  // namespace cdpr
+

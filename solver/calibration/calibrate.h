@@ -119,8 +119,12 @@ std::vector<Sample> leave_out(const std::vector<Sample>& samples, const std::vec
 // The robust fit (CalibrationOptions::robust), a restart with a looser
 // height consistency when the first fit stops where the anchors are
 // unobservable, the rows of gross errors left out and the fit redone, and
-// the model-fit test. Refuses (ok = false) when more than
-// max_rejected_fraction of the rows have gross errors.
+// the model-fit test. When that fit may not be at the minimum (it failed,
+// left rows or readings out, or misfits), other starts are fitted too and
+// the best fit kept (solver/calibration/start_selection.h), and on small
+// sets the readings left out are checked against their row's and cable's
+// other readings (docs/robust-calibration.md). Refuses (ok = false) when
+// more than max_rejected_fraction of the rows have gross errors.
 CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& samples,
                             const CalibrationOptions& options);
 

@@ -47,4 +47,38 @@ double largest_normalised_residual(const std::vector<ReadingResidual>& residuals
   return largest;
 }
 
+std::vector<SensorReading> confirm_left_out(const std::vector<SensorReading>& candidates,
+                                            const std::vector<SensorReading>& predicted, bool refit_ok,
+                                            double bar_sigma) {
+  auto prediction = [&](const SensorReading& r) -> const SensorReading* {
+    if (!refit_ok) return nullptr;
+    const auto p = std::find_if(predicted.begin(), predicted.end(), [&](const SensorReading& q) {
+      return q.row == r.row && q.sensor == r.sensor && q.cable == r.cable;
+    });
+    return p != predicted.end() && std::isfinite(p->value) ? &*p : nullptr;
+  };
+  std::vector<SensorReading> confirmed;
+  for (const SensorReading& r : candidates) {
+    const SensorReading* p = prediction(r);
+    if (!p) {
+      if (std::isfinite(r.value)) confirmed.push_back(r);
+      continue;
+    }
+    if (std::abs(p->value) <= bar_sigma) continue;
+    if (std::isnan(r.value)) {
+      // A hypothesis row's readings were all left out, so each is predicted
+      // from its row's pose prior alone and good ones look bad too: only the
+      // one predicted farthest off stays out.
+      const bool farthest = std::none_of(candidates.begin(), candidates.end(), [&](const SensorReading& o) {
+        const SensorReading* q = std::isnan(o.value) && o.row == r.row ? prediction(o) : nullptr;
+        return q && std::abs(q->value) > std::abs(p->value);
+      });
+      if (!farthest) continue;
+    }
+    confirmed.push_back(r);
+    if (std::isnan(r.value)) confirmed.back().value = p->value;
+  }
+  return confirmed;
+}
+
 }  // namespace cdpr

@@ -44,4 +44,19 @@ std::vector<SensorReading> gross_errors(const std::vector<ReadingResidual>& resi
 // The largest normalised residual (0 when there are none).
 double largest_normalised_residual(const std::vector<ReadingResidual>& residuals);
 
+// The final test of the readings a fit left out: `candidates` (their value
+// the normalised residual that flagged them, NaN for a reading left out only
+// because its whole row was a hypothesis) against `predicted`, each as the
+// refit without it predicts it (a leave-one-out residual). A reading stays
+// out when the refit predicts it beyond bar_sigma, or when the refit failed
+// or has no prediction for it and it was flagged by its own residual; it
+// then carries the prediction's size when its own was unknown. Of a
+// hypothesis row (all its readings left out, so each is predicted from the
+// row's pose prior alone) only the reading predicted farthest off stays
+// out. A hypothesis reading nothing confirms goes back in, so no NaN is
+// ever reported.
+std::vector<SensorReading> confirm_left_out(const std::vector<SensorReading>& candidates,
+                                            const std::vector<SensorReading>& predicted, bool refit_ok,
+                                            double bar_sigma);
+
 }  // namespace cdpr

@@ -1,5 +1,8 @@
 #include "solver/calibration/gross_errors.h"
 
+#include <cmath>
+#include <limits>
+
 #include <gtest/gtest.h>
 
 namespace cdpr {
@@ -39,6 +42,56 @@ TEST(GrossErrors, SpreadFloorsAtTheSigmasAndGrowsWithNoisierData) {
   EXPECT_TRUE(gross_errors(residuals, 5.0).empty());
   // AND residuals smaller than the sigmas keep the sigmas as the spread
   EXPECT_DOUBLE_EQ(reading_spreads(clean_encoders(20, 0.1)).encoder, 1.0);
+}
+
+TEST(GrossErrors, LeftOutReadingsAreConfirmedByTheRefitsPrediction) {
+  // GIVEN four readings left out: two flagged by their own residual, two
+  // only because their row was a hypothesis (value unknown)
+  const double unknown = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<SensorReading> candidates{{1, SensorKind::kEncoder, 0, 40.0},
+                                              {2, SensorKind::kEncoder, 3, -12.0},
+                                              {5, SensorKind::kEncoder, 1, unknown},
+                                              {5, SensorKind::kForce, 0, unknown}};
+  // and the refit predicting three of them: one far off, two within the bar
+  const std::vector<SensorReading> predicted{{1, SensorKind::kEncoder, 0, 2.0},
+                                             {2, SensorKind::kEncoder, 3, -30.0},
+                                             {5, SensorKind::kEncoder, 1, 1.5}};
+  // WHEN confirmed at 5 sigma
+  const std::vector<SensorReading> confirmed = confirm_left_out(candidates, predicted, true, 5.0);
+  // THEN only the one predicted far off stays out; the hypothesis reading
+  // without a prediction goes back in rather than being reported as NaN
+  ASSERT_EQ(confirmed.size(), 1u);
+  EXPECT_EQ(confirmed[0].row, 2);
+  EXPECT_DOUBLE_EQ(confirmed[0].value, -12.0);
+}
+
+TEST(GrossErrors, AFailedRefitKeepsOnlyReadingsFlaggedByTheirOwnResidual) {
+  // GIVEN a flagged reading and a row hypothesis whose refit failed
+  const double unknown = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<SensorReading> candidates{{3, SensorKind::kForce, 0, -70.0},
+                                              {4, SensorKind::kEncoder, 2, unknown}};
+  // WHEN confirmed without a usable refit (its predictions, if any, are not trusted)
+  const std::vector<SensorReading> confirmed =
+      confirm_left_out(candidates, {{4, SensorKind::kEncoder, 2, unknown}}, false, 5.0);
+  // THEN the flagged reading stays out with its own residual and no NaN is left
+  ASSERT_EQ(confirmed.size(), 1u);
+  EXPECT_EQ(confirmed[0].row, 3);
+  EXPECT_DOUBLE_EQ(confirmed[0].value, -70.0);
+}
+
+TEST(GrossErrors, OfAHypothesisRowOnlyTheReadingPredictedFarthestOffStaysOut) {
+  // GIVEN a row hypothesis: two of its readings predicted beyond the bar
+  // (from the pose prior alone, good readings look bad too)
+  const double unknown = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<SensorReading> candidates{{6, SensorKind::kEncoder, 1, unknown},
+                                              {6, SensorKind::kForce, 0, unknown}};
+  // WHEN confirmed
+  const std::vector<SensorReading> confirmed = confirm_left_out(
+      candidates, {{6, SensorKind::kEncoder, 1, 25.0}, {6, SensorKind::kForce, 0, -12.0}}, true, 5.0);
+  // THEN only the farthest stays out, reported with the predicted size
+  ASSERT_EQ(confirmed.size(), 1u);
+  EXPECT_EQ(confirmed[0].sensor, SensorKind::kEncoder);
+  EXPECT_DOUBLE_EQ(confirmed[0].value, 25.0);
 }
 
 }  // namespace

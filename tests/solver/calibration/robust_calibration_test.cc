@@ -27,6 +27,22 @@ sim::DatasetConfig large(int poses, std::uint64_t seed) {
   return c;
 }
 
+sim::DatasetConfig small(int poses, std::uint64_t seed) {
+  sim::DatasetConfig c;
+  c.preset = sim::Preset::kSmall;
+  c.pose_count = poses;
+  c.seed = seed;
+  c.anchor_perturbation_m = 1.0;
+  return c;
+}
+
+// 5 % rows with a 0.5-2 m encoder error and 5 % with a load-cell spike.
+sim::DatasetConfig with_gross_errors(sim::DatasetConfig config) {
+  config.gross_errors.encoder_fraction = 0.05;
+  config.gross_errors.force_fraction = 0.05;
+  return config;
+}
+
 double mean_anchor_error(const Calibration& cal, const Truth& truth) {
   double sum = 0.0;
   for (int i = 0; i < kCableCount; ++i) sum += (cal.winches[i].anchor_world - truth.winches[i].anchor_world).norm();
@@ -96,18 +112,8 @@ TEST(RobustCalibration, TooManyGrossErrorsAreRefusedWithTheReason) {
   EXPECT_FALSE(result.gross_errors.empty());
 }
 
-TEST(RobustCalibration, OneGrossErrorThatCapturesTheRobustFitOnNinePosesIsStillFound) {
-  // GIVEN 9 poses, nominal anchors 10 m off, one row with a 1.7 m encoder
-  // error whose leverage pulls the robust fit where most rows look bad
-  sim::DatasetConfig config = large(9, 18);
-  config.gross_errors.encoder_fraction = 0.05;
-  config.gross_errors.force_fraction = 0.05;
-  const sim::SimulatedDataset data = simulate(config);
-  // WHEN calibrated with default options
-  const CalibrationResult result = calibrate(data.nominal, data.samples, CalibrationOptions{});
-  // THEN the leave-one-row-out hypotheses find the bad row: the fit is kept,
-  // every planted reading named and only readings of planted rows left out
-  ASSERT_TRUE(result.ok) << result.message;
+// Every planted reading named, and no reading of a clean row left out.
+void expect_exactly_the_planted_rows(const CalibrationResult& result, const sim::SimulatedDataset& data) {
   for (const SensorReading& planted : data.truth.outliers) {
     EXPECT_TRUE(std::any_of(result.calibration.rejected.begin(), result.calibration.rejected.end(),
                             [&](const SensorReading& r) {
@@ -121,21 +127,96 @@ TEST(RobustCalibration, OneGrossErrorThatCapturesTheRobustFitOnNinePosesIsStillF
                             [&](const SensorReading& planted) { return planted.row == r.row; }))
         << "clean row " << r.row << " left out";
   }
+}
+
+TEST(RobustCalibration, OneGrossErrorThatCapturesTheRobustFitOnNinePosesIsStillFound) {
+  // GIVEN 9 poses, nominal anchors 10 m off, one row with a 1.7 m encoder
+  // error whose leverage pulls the robust fit where most rows look bad
+  const sim::SimulatedDataset data = simulate(with_gross_errors(large(9, 18)));
+  // WHEN calibrated with default options
+  const CalibrationResult result = calibrate(data.nominal, data.samples, CalibrationOptions{});
+  // THEN the leave-one-row-out hypotheses find the bad row: the fit is kept,
+  // every planted reading named and only readings of planted rows left out
+  ASSERT_TRUE(result.ok) << result.message;
+  expect_exactly_the_planted_rows(result, data);
   EXPECT_LT(mean_anchor_error(result.calibration, data.truth), 2.0);
+}
+
+TEST(RobustCalibration, AStartThatCannotTakeEveryRowStillReachesTheTruthStartedMinimum) {
+  // GIVEN 9 clean poses of the large robot with nominal anchors 20 m off,
+  // from which 3 rows cannot be started (their cable geometry is infeasible)
+  sim::DatasetConfig config = large(9, 22);
+  config.anchor_perturbation_m = 20.0;
+  const auto simulated = sim::simulate_dataset(config);
+  ASSERT_TRUE(simulated) << simulated.error();
+  const sim::SimulatedDataset& data = *simulated;
+  Robot at_truth = data.nominal;
+  for (int i = 0; i < kCableCount; ++i) at_truth.winches[i].anchor_world = data.truth.winches[i].anchor_world;
+  // WHEN calibrated from the nominal anchors and from the true ones
+  const CalibrationResult result = calibrate(data.nominal, data.samples, CalibrationOptions{});
+  const CalibrationResult reference = calibrate(at_truth, data.samples, CalibrationOptions{});
+  // THEN the multi-start fits every row and ends at the same minimum
+  ASSERT_TRUE(result.ok) << result.message;
+  ASSERT_TRUE(reference.ok) << reference.message;
+  EXPECT_EQ(result.calibration.samples, 9);
+  EXPECT_TRUE(result.rejected_samples.empty());
+  EXPECT_NEAR(result.solver.final_cost, reference.solver.final_cost, 1e-6 * reference.solver.final_cost);
+}
+
+// 5 % rows with an encoder error and 5 % with a load-cell spike planted on
+// `config`, calibrated with default options: exactly the planted readings
+// named, no misfit, the anchors within max_error_m.
+void expect_planted_named_without_misfit(const sim::DatasetConfig& config, double max_error_m) {
+  const auto simulated = sim::simulate_dataset(with_gross_errors(config));
+  ASSERT_TRUE(simulated) << simulated.error();
+  const CalibrationResult result = calibrate(simulated->nominal, simulated->samples, CalibrationOptions{});
+  ASSERT_TRUE(result.ok) << result.message;
+  expect_exactly_the_planted_rows(result, *simulated);
+  EXPECT_FALSE(result.misfit) << result.calibration.model_warning;
+  EXPECT_LT(mean_anchor_error(result.calibration, simulated->truth), max_error_m);
+}
+
+TEST(RobustCalibration, ARefusalAfterARowHypothesisNamesOnlyMeasuredResiduals) {
+  // GIVEN 9 poses, nominal anchors 10 m off, 20 % rows with an encoder
+  // error and 5 % with a load-cell spike, where the leave-one-row-out
+  // hypotheses run and the run is still refused
+  sim::DatasetConfig config = large(9, 21);
+  config.gross_errors.encoder_fraction = 0.2;
+  config.gross_errors.force_fraction = 0.05;
+  const auto simulated = sim::simulate_dataset(config);
+  ASSERT_TRUE(simulated) << simulated.error();
+  // WHEN calibrated with default options
+  const CalibrationResult result = calibrate(simulated->nominal, simulated->samples, CalibrationOptions{});
+  // THEN every reading it names has a residual, in the message too
+  for (const SensorReading& r : result.gross_errors) EXPECT_TRUE(std::isfinite(r.value)) << "row " << r.row;
+  EXPECT_EQ(result.message.find("nan"), std::string::npos) << result.message;
+}
+
+TEST(RobustCalibration, AGrossErrorAbsorbedByItsRowsLoadCellIsStillNamed) {
+  // GIVEN 9 poses, nominal anchors 10 m off, a 0.51 m encoder error that
+  // the robust fit's leave-one-out puts on its row's load cell (whose
+  // absence lets the row's force absorb it), and a load-cell spike
+  // WHEN calibrated with default options
+  // THEN the swap test moves the rejection to the encoder: both planted
+  // readings named, nothing else left out, no misfit
+  expect_planted_named_without_misfit(large(9, 50), 2.0);
+}
+
+TEST(RobustCalibration, AGrossErrorAbsorbedByItsCableIsStillNamed) {
+  // GIVEN 8 poses of the small robot, nominal anchors 1 m off, a 1.49 m
+  // encoder error that cable 0's anchor and offset absorb, so that cable
+  // 0's readings of two other rows look bad, and a load-cell spike
+  const sim::DatasetConfig config = small(8, 33);
+  // WHEN calibrated with default options
+  // THEN the swap test trades the good readings for the bad one
+  expect_planted_named_without_misfit(config, 1.0);
 }
 
 TEST(RobustCalibration, AFitThatKeptAGrossErrorAndMisfitsIsRedoneFromTheBadRowLeftOut) {
   // GIVEN 8 poses of the small robot, nominal anchors 1 m off, a 1.75 m
   // encoder error and a load-cell spike, where the robust fit flags good
   // readings, keeps the bad one and its refit misfits
-  sim::DatasetConfig config;
-  config.preset = sim::Preset::kSmall;
-  config.pose_count = 8;
-  config.seed = 45;
-  config.anchor_perturbation_m = 1.0;
-  config.gross_errors.encoder_fraction = 0.05;
-  config.gross_errors.force_fraction = 0.05;
-  const sim::SimulatedDataset data = simulate(config);
+  const sim::SimulatedDataset data = simulate(with_gross_errors(small(8, 45)));
   // WHEN calibrated with default options
   const CalibrationResult result = calibrate(data.nominal, data.samples, CalibrationOptions{});
   // THEN the leave-one-row-out hypotheses find the fit that leaves out every
