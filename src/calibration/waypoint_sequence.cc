@@ -43,7 +43,7 @@ std::string WaypointSequence::start(const Robot& robot, const std::array<double,
   used_.assign(plan_.waypoints.size(), false);
   sequential_.emplace(robot, plan_.waypoints, start_pose_, sequential);
   index_ = sequential_->next();
-  time_left_s_ = -1.0;  // known after the first re-solve
+  time_left_s_ = modelled_left_s();
   return "";
 }
 
@@ -114,8 +114,12 @@ double WaypointSequence::modelled_s(const Pose& from, const Pose& to) const {
 double WaypointSequence::modelled_left_s() const {
   if (sequential_) {
     const SequentialStatus s = sequential_->status();
-    if (!s.solved) return -1.0;
-    return visited_ > 0 ? s.estimated_samples_left * modelled_spent_s_ / visited_ : 0.0;
+    const double per_waypoint_s = visited_ > 0 ? modelled_spent_s_ / visited_ : sequential_options_.settle_s;
+    if (s.solved) return s.estimated_samples_left * per_waypoint_s;
+    // Before the first re-solve: at least the rest of the initial set.
+    const auto initial_left = std::count_if(sequential_->initial().begin(), sequential_->initial().end(),
+                                            [&](int k) { return !used_[k]; });
+    return initial_left > 0 ? static_cast<double>(initial_left) * per_waypoint_s : -1.0;
   }
   double left_s = 0.0;
   Pose from = at_;

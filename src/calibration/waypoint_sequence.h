@@ -15,7 +15,8 @@
 // Time left: the remaining waypoints' modelled time (move at the winch
 // speed plus the expected settle, as the sequential planner models it; for
 // the sequential strategy its estimate of the samples still needed from the
-// sigma trend) scaled by how the robot time spent so far compared with the
+// sigma trend; before its first re-solve, the rest of its initial set: a
+// lower bound) scaled by how the robot time spent so far compared with the
 // model. The run's own clock measures, so the estimate follows the robot
 // (or a virtual robot's time scale).
 // Pure logic: no I/O; times are passed in.

@@ -116,13 +116,13 @@ std::string format_status_response(const calibration::CalibrationStatus& status,
   json["samples"] = status.samples;
   json["skipped"] = status.skipped;
   json["progress"] = status.progress;
-  add_waypoint_progress(status, now_us, json);
   if (status.started_us < 0) {
     json["elapsed_s"] = nullptr;
   } else {
     const hal::TimeUs end_us = status.finished_us >= 0 ? status.finished_us : now_us;
     json["elapsed_s"] = 1e-6 * static_cast<double>(end_us - status.started_us);
   }
+  add_waypoint_progress(status, now_us, json);
   json["reason"] = status.reason;
   json["note"] = status.note;
   json["detail"] = status.detail;
