@@ -4,6 +4,7 @@
 
 #include <array>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,15 @@ inline const char* sensor_name(SensorKind kind) { return kind == SensorKind::kEn
 // scalars hold one value, per-cable terms one value per cable.
 using EffectValues = std::map<std::string, std::vector<double>>;
 
+// How the daemon's run behind a fit went (calibration.toml [run]); offline
+// fits have none.
+struct RunSummary {
+  double robot_time_s = 0.0;  // from the run's start to the fit's acceptance [s]
+  int waypoints = 0;          // visited: sampled or skipped
+  std::string strategy;       // "spread", "informative" or "sequential"
+  std::string stop;           // why the waypoints ended ("plan done", "target reached", ...)
+};
+
 struct Calibration {
   int format = 1;
   std::string created;  // RFC 3339 UTC, e.g. 2026-11-22T10:15:00Z
@@ -60,6 +70,7 @@ struct Calibration {
   // the evidence (chi-square of the residuals against the noise, or an
   // under-determined problem). Sigmas are already scaled up by the misfit.
   std::string model_warning;
+  std::optional<RunSummary> run;
 };
 
 struct WinchTruth {

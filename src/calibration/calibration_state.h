@@ -51,6 +51,21 @@ struct CalibrationStatus {
   // run.toml: "running", "committed", "failed", "aborted"; empty before a run.
   std::string run_entry;
   std::string run_outcome;
+  // The waypoint strategy of the run ("spread", "informative",
+  // "sequential"; empty before planning), and why its waypoints ended
+  // ("plan done", "target reached", "max count", "no candidates left").
+  std::string strategy;
+  std::string stop_reason;
+  // Largest anchor-axis and offset 1-sigma [m] of the sequential strategy's
+  // last re-solve, then of the run's fit; < 0 while unknown. Their targets.
+  double largest_anchor_sigma_m = -1.0;
+  double largest_offset_sigma_m = -1.0;
+  double target_anchor_sigma_m = 0.0;
+  double target_offset_sigma_m = 0.0;
+  // Robot time [s] the remaining waypoints are estimated to take, as
+  // estimated at time_left_at_us (the last waypoint's end); < 0 unknown.
+  double time_left_s = -1.0;
+  hal::TimeUs time_left_at_us = -1;
   // The model check's one-line verdict on the last run's data
   // (model_check_verdict.h), once the owner has it; empty before.
   std::string run_diagnosis;

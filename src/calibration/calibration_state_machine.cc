@@ -1,5 +1,6 @@
 #include "src/calibration/calibration_state_machine.h"
 
+#include <algorithm>
 #include <utility>
 
 #include "src/calibration/message_text.h"
@@ -58,8 +59,7 @@ bool CalibrationStateMachine::request_start(hal::TimeUs now_us) {
   status_.note = "started";
   enable_sent_us_.reset();
   previous_.reset();
-  plan_ = WaypointPlan{};
-  waypoint_index_ = 0;
+  waypoints_ = WaypointSequence{};
   samples_.clear();
   solve_result_.reset();
   fit_validated_ = false;
@@ -247,19 +247,24 @@ void CalibrationStateMachine::run_plan(hal::TimeUs now_us) {
     if (!estimated) return fail("plan: " + estimated.error(), now_us, false);
     offsets_m = *estimated;
   }
-  plan_ = plan_waypoints(planning_robot, offsets_m, start_world, options_.planner);
-  if (!plan_.ok()) return fail("plan: " + plan_.problem, now_us, false);
-  status_.waypoint_count = static_cast<int>(plan_.waypoints.size());
+  SequentialOptions sequential = options_.sequential;
+  sequential.min_count = options_.validation.min_samples;
+  if (const std::string problem = waypoints_.start(planning_robot, offsets_m, start_world, options_.planner,
+                                                   options_.strategy, sequential, now_us);
+      !problem.empty()) {
+    return fail("plan: " + problem, now_us, false);
+  }
+  status_.waypoint_count = waypoints_.planned();
   run_log_.waypoints_planned = status_.waypoint_count;
+  update_waypoint_status();
   log_run(now_us);
-  waypoint_index_ = 0;
   targets_sent_ = false;
   enter(CalibrationState::kMove, now_us);
   status_.waypoint = 1;
 }
 
 void CalibrationStateMachine::run_move(hal::TimeUs now_us) {
-  const Waypoint& waypoint = plan_.waypoints[waypoint_index_];
+  const Waypoint& waypoint = *waypoints_.current();
   if (!targets_sent_) {
     // All four together: they start and arrive at the same time.
     if (const hal::Status s = devices_.winches.set_target_payouts(waypoint.payout_m.data()); !s.ok()) {
@@ -310,6 +315,7 @@ void CalibrationStateMachine::run_settle(hal::TimeUs now_us) {
                                   "no equilibrium within " + seconds(options_.settle_timeout_us) + " (" +
                                       status_.detail + ")"});
     run_log_.skipped = status_.skipped;
+    waypoints_.skipped(now_us);
     log_run(now_us);
     next_waypoint(now_us);
   }
@@ -321,23 +327,26 @@ void CalibrationStateMachine::run_sample(hal::TimeUs now_us) {
   sample.id = static_cast<int>(samples_.size());
   samples_.push_back(sample);
   status_.samples = static_cast<int>(samples_.size());
-  run_log_.waypoints.push_back({status_.waypoint, "sampled", run_seconds(now_us), sample.id, ""});
+  waypoints_.sampled(sample, now_us);
+  // A remark on how the next waypoint was chosen (a failed re-solve) goes with this one.
+  if (!waypoints_.remark().empty()) status_.note = waypoints_.remark();
+  run_log_.waypoints.push_back({status_.waypoint, "sampled", run_seconds(now_us), sample.id, waypoints_.remark()});
   run_log_.samples = status_.samples;
   log_run(now_us);
   next_waypoint(now_us);
 }
 
 void CalibrationStateMachine::next_waypoint(hal::TimeUs now_us) {
-  ++waypoint_index_;
-  if (waypoint_index_ < static_cast<int>(plan_.waypoints.size())) {
+  update_waypoint_status();
+  if (waypoints_.current()) {
     targets_sent_ = false;
     enter(CalibrationState::kMove, now_us);
-    status_.waypoint = waypoint_index_ + 1;
+    status_.waypoint = waypoints_.visited() + 1;
     return;
   }
   if (const hal::Status s = devices_.winches.halt(); !s.ok()) return fail("halt: " + s.to_string(), now_us, true);
   if (static_cast<int>(samples_.size()) < options_.validation.min_samples) {
-    return fail("only " + std::to_string(samples_.size()) + " of " + std::to_string(plan_.waypoints.size()) +
+    return fail("only " + std::to_string(samples_.size()) + " of " + std::to_string(waypoints_.visited()) +
                     " waypoints settled (at least " + std::to_string(options_.validation.min_samples) + " needed)",
                 now_us, false);
   }
@@ -375,6 +384,11 @@ void CalibrationStateMachine::run_validate_and_commit(hal::TimeUs now_us) {
     if (calibration.created.empty()) calibration.created = "1970-01-01T00:00:00Z";
     calibration.robot = robot_.name;
     calibration.samples = static_cast<int>(samples_.size());
+    for (const WinchCalibration& w : calibration.winches) {
+      status_.largest_anchor_sigma_m = std::max(status_.largest_anchor_sigma_m, w.anchor_sigma.maxCoeff());
+      status_.largest_offset_sigma_m = std::max(status_.largest_offset_sigma_m, w.offset_sigma_m);
+    }
+    calibration.run = RunSummary{run_seconds(now_us), waypoints_.visited(), status_.strategy, status_.stop_reason};
     fit_validated_ = true;
     enter(CalibrationState::kCommit, now_us);
     return;
@@ -432,7 +446,25 @@ void CalibrationStateMachine::update_progress() {
     case CalibrationState::kAbort:
     case CalibrationState::kFailed: return;
   }
-  status_.progress = kWaypointsStart + kWaypointsSpan * (waypoint_index_ + phase) / count;
+  status_.progress = kWaypointsStart + kWaypointsSpan * std::min(1.0, (waypoints_.visited() + phase) / count);
+}
+
+const Waypoint* CalibrationStateMachine::current_waypoint() const {
+  const CalibrationState state = status_.state;
+  const bool at_waypoint =
+      state == CalibrationState::kMove || state == CalibrationState::kSettle || state == CalibrationState::kSample;
+  return at_waypoint ? waypoints_.current() : nullptr;
+}
+
+void CalibrationStateMachine::update_waypoint_status() {
+  status_.strategy = run_log_.strategy = to_string(waypoints_.strategy());
+  status_.stop_reason = run_log_.stop = waypoints_.stop_reason();
+  status_.target_anchor_sigma_m = options_.sequential.target_anchor_sigma_m;
+  status_.target_offset_sigma_m = options_.sequential.target_offset_sigma_m;
+  status_.largest_anchor_sigma_m = waypoints_.largest_anchor_sigma_m().value_or(-1.0);
+  status_.largest_offset_sigma_m = waypoints_.largest_offset_sigma_m().value_or(-1.0);
+  status_.time_left_s = waypoints_.current() ? waypoints_.time_left_s() : 0.0;
+  status_.time_left_at_us = waypoints_.estimated_at_us();
 }
 
 }  // namespace cdpr::calibration

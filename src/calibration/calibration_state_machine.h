@@ -13,13 +13,18 @@
 //            operation enabled (enable_timeout_us). Encoder offsets for the
 //            payout targets: the current calibration's, else estimated at the
 //            start pose (waypoint_planner.h).
-// plan       plan_waypoints() with the current calibration's anchors when one
-//            exists, else the nominal ones; an infeasible plan fails the run.
+// plan       the waypoints (waypoint_sequence.h) with the current
+//            calibration's anchors when one exists, else the nominal ones: a
+//            fixed plan (spread, informative) or the sequential strategy's
+//            candidates; an infeasible plan fails the run.
 // move       payout targets sent; waits for motion_finished() (move_timeout_us
 //            is a fault: a winch is stuck).
 // settle     EquilibriumDetector on every new pose; settle_timeout_us without
 //            equilibrium skips the waypoint (noted), it is not a fault.
-// sample     the window's average becomes one sample row.
+// sample     the window's average becomes one sample row. The sequential
+//            strategy re-solves with the rows so far and picks the next
+//            waypoint here (milliseconds: inside step()); when its stop rule
+//            ends the waypoints, the run goes on to solve.
 // solve      after the last waypoint the winches are halted (hold). With a
 //            SolveFunction the solve runs inside step(); without, the owner
 //            polls solve_pending(), runs calibrate() on samples() wherever it
@@ -64,6 +69,7 @@
 #include "src/calibration/fit_validation.h"
 #include "src/calibration/hardware_monitor.h"
 #include "src/calibration/waypoint_planner.h"
+#include "src/calibration/waypoint_sequence.h"
 #include "src/formats/run_log_toml.h"
 #include "src/store/calibration_store.h"
 
@@ -71,6 +77,10 @@ namespace cdpr::calibration {
 
 struct CalibratorOptions {
   PlannerOptions planner;
+  WaypointStrategy strategy = WaypointStrategy::kSpread;
+  // The sequential strategy's targets, max_count and time model; its
+  // min_count is validation.min_samples, so that a run it stops can be accepted.
+  SequentialOptions sequential;
   EquilibriumThresholds equilibrium;
   std::size_t equilibrium_capacity = 1024;  // >= window x pose rate, with margin
   ValidationLimits validation;
@@ -148,7 +158,10 @@ class CalibrationStateMachine {
   const CalibrationResult* validated_result() const { return fit_validated_ ? &*solve_result_ : nullptr; }
 
   const CalibrationStatus& status() const { return status_; }
-  const WaypointPlan& plan() const { return plan_; }
+  // The fixed plan's waypoints in travel order, or the sequential strategy's candidates.
+  const WaypointPlan& plan() const { return waypoints_.plan(); }
+  // The waypoint being worked on (move .. sample); null otherwise.
+  const Waypoint* current_waypoint() const;
 
  private:
   void enter(CalibrationState state, hal::TimeUs now_us);
@@ -167,6 +180,8 @@ class CalibrationStateMachine {
   // Keeps a fit whose commit failed in <state>/pending; the sentence for the reason.
   std::string keep_pending(const Calibration& calibration) const;
   void update_progress();
+  // The run's strategy, sigmas and time left into the status and the run log.
+  void update_waypoint_status();
   // run_log_ at now_us: robot time, and the outcome into the status too.
   void log_run(hal::TimeUs now_us, const char* outcome = nullptr);
   double run_seconds(hal::TimeUs now_us) const;
@@ -183,8 +198,7 @@ class CalibrationStateMachine {
   // Per run:
   std::optional<hal::TimeUs> enable_sent_us_;  // when preflight commanded the drives on
   std::optional<store::CurrentCalibration> previous_;
-  WaypointPlan plan_;
-  int waypoint_index_ = 0;  // 0-based
+  WaypointSequence waypoints_;
   bool targets_sent_ = false;
   std::vector<Sample> samples_;
   std::optional<CalibrationResult> solve_result_;

@@ -1,5 +1,6 @@
 #include "src/control/control_response.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -80,6 +81,29 @@ Json refit_json(const std::optional<RefitStatus>& refit) {
   return json;
 }
 
+// The run's waypoint strategy, its largest sigmas against their targets
+// and the robot time still needed, for `calibctl status`.
+void add_waypoint_progress(const calibration::CalibrationStatus& status, hal::TimeUs now_us, Json& json) {
+  json["strategy"] = status.strategy;
+  json["stop_reason"] = status.stop_reason;
+  if (status.largest_anchor_sigma_m < 0.0) {
+    json["sigma"] = nullptr;
+  } else {
+    Json sigma;
+    sigma["anchor"] = status.largest_anchor_sigma_m;
+    sigma["offset"] = status.largest_offset_sigma_m;
+    sigma["target_anchor"] = status.target_anchor_sigma_m;
+    sigma["target_offset"] = status.target_offset_sigma_m;
+    json["sigma"] = std::move(sigma);
+  }
+  if (status.time_left_s < 0.0 || !calibration::is_running(status.state)) {
+    json["time_left_s"] = nullptr;
+  } else {
+    const double since_s = 1e-6 * static_cast<double>(now_us - status.time_left_at_us);
+    json["time_left_s"] = std::max(0.0, status.time_left_s - since_s);
+  }
+}
+
 }  // namespace
 
 std::string format_error_response(std::string_view reason) {
@@ -113,6 +137,7 @@ std::string format_status_response(const calibration::CalibrationStatus& status,
     const hal::TimeUs end_us = status.finished_us >= 0 ? status.finished_us : now_us;
     json["elapsed_s"] = 1e-6 * static_cast<double>(end_us - status.started_us);
   }
+  add_waypoint_progress(status, now_us, json);
   json["reason"] = status.reason;
   json["note"] = status.note;
   json["detail"] = status.detail;

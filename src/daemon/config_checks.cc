@@ -141,11 +141,14 @@ std::optional<FormatError> check_load_cell(const DaemonConfig& c) {
 
 std::optional<FormatError> check_counts_and_times(const DaemonConfig& c) {
   const calibration::CalibratorOptions& o = c.calibrator;
-  if (o.validation.min_samples > o.planner.waypoint_count) {
-    return problem(c, line_of(c, "validation.min_samples") > 0 ? "validation.min_samples" : "waypoints.count",
-                   "validation.min_samples (" + std::to_string(o.validation.min_samples) +
-                       ") is more than waypoints.count (" + std::to_string(o.planner.waypoint_count) +
-                       "): no run could be accepted");
+  // The waypoints a run can sample at most: the fixed plan's, or the sequential strategy's maximum.
+  const bool sequential = o.strategy == calibration::WaypointStrategy::kSequential;
+  const std::string count_key = sequential ? "waypoints.max_count" : "waypoints.count";
+  const int count = sequential ? o.sequential.max_count : o.planner.waypoint_count;
+  if (o.validation.min_samples > count) {
+    return problem(c, line_of(c, "validation.min_samples") > 0 ? "validation.min_samples" : count_key,
+                   "validation.min_samples (" + std::to_string(o.validation.min_samples) + ") is more than " +
+                       count_key + " (" + std::to_string(count) + "): no run could be accepted");
   }
   if (static_cast<std::size_t>(o.equilibrium.min_samples) > o.equilibrium_capacity) {
     return problem(c, "equilibrium.min_samples",

@@ -103,31 +103,47 @@ Table<CalibratorOptions> limits_table() {
   return t;
 }
 
-Table<PlannerOptions> waypoints_table() {
-  Table<PlannerOptions> t("waypoints");
-  t.integer("count", &PlannerOptions::waypoint_count, 35, {1, 10'000}, "", "static poses per calibration");
-  t.number("margin", &PlannerOptions::margin_m, 20.0, kNonNegative, "m",
+// A [waypoints] row's field: a member of the planner's options.
+template <class V>
+auto planner(V PlannerOptions::*member) {
+  return [member](auto& o) -> auto& { return o.planner.*member; };
+}
+
+Table<CalibratorOptions> waypoints_table() {
+  Table<CalibratorOptions> t("waypoints");
+  t.choice("strategy", &CalibratorOptions::strategy,
+           {{"spread", calibration::WaypointStrategy::kSpread},
+            {"informative", calibration::WaypointStrategy::kInformative},
+            {"sequential", calibration::WaypointStrategy::kSequential}},
+           calibration::WaypointStrategy::kSpread,
+           "a fixed plan of `count` waypoints evenly over the feasible candidates, or those that determine anchors "
+           "and offsets best; or sequential: re-solve after each sample, pick the next waypoint by the variance it "
+           "removes per second of robot time, stop at the targets");
+  t.integer("count", planner(&PlannerOptions::waypoint_count), 35, {1, 10'000}, "",
+            "static poses per calibration (spread, informative)");
+  t.number("target_anchor_sigma", [](auto& o) -> auto& { return o.sequential.target_anchor_sigma_m; }, 0.02,
+           kPositive, "m", "sequential: stop when every anchor axis 1-sigma is at most this");
+  t.number("target_offset_sigma", [](auto& o) -> auto& { return o.sequential.target_offset_sigma_m; }, 0.02,
+           kPositive, "m", "sequential: ... and every encoder offset 1-sigma at most this");
+  t.integer("max_count", [](auto& o) -> auto& { return o.sequential.max_count; }, 35, {1, 10'000}, "",
+            "sequential: stop after this many samples whatever the sigmas");
+  t.number("margin", planner(&PlannerOptions::margin_m), 20.0, kNonNegative, "m",
            "inset from the anchors' horizontal footprint");
-  t.number("z_min", &PlannerOptions::z_min_m, 5.0, kAnyNumber, "m", "world height band of the platform origin");
-  t.number("z_max", &PlannerOptions::z_max_m, 35.0, kAnyNumber, "m", "");
-  t.integer("grid_xy", &PlannerOptions::grid_xy, 8, {1, 1000}, "", "candidate grid per horizontal axis");
-  t.integer("grid_z", &PlannerOptions::grid_z, 4, {1, 1000}, "", "candidate grid along z");
-  t.number("jitter", &PlannerOptions::jitter_fraction, 0.3, {0.0, 0.5, false, true}, "",
+  t.number("z_min", planner(&PlannerOptions::z_min_m), 5.0, kAnyNumber, "m", "world height band of the platform origin");
+  t.number("z_max", planner(&PlannerOptions::z_max_m), 35.0, kAnyNumber, "m", "");
+  t.integer("grid_xy", planner(&PlannerOptions::grid_xy), 8, {1, 1000}, "", "candidate grid per horizontal axis");
+  t.integer("grid_z", planner(&PlannerOptions::grid_z), 4, {1, 1000}, "", "candidate grid along z");
+  t.number("jitter", planner(&PlannerOptions::jitter_fraction), 0.3, {0.0, 0.5, false, true}, "",
            "candidate jitter, fraction of the grid step");
-  t.integer("seed", &PlannerOptions::seed, 1, {0, 2'147'483'647}, "", "same seed, same plan");
-  t.number("min_tension", &PlannerOptions::min_tension_n, 20.0, kNonNegative, "N",
+  t.integer("seed", planner(&PlannerOptions::seed), 1, {0, 2'147'483'647}, "", "same seed, same plan");
+  t.number("min_tension", planner(&PlannerOptions::min_tension_n), 20.0, kNonNegative, "N",
            "every cable at every waypoint (catenary statics)");
-  t.number("max_tension", &PlannerOptions::max_tension_n, 3000.0, kPositive, "N", "");
-  t.number("min_payout", &PlannerOptions::min_payout_m, -1e9, kAnyNumber, "m",
+  t.number("max_tension", planner(&PlannerOptions::max_tension_n), 3000.0, kPositive, "N", "");
+  t.number("min_payout", planner(&PlannerOptions::min_payout_m), -1e9, kAnyNumber, "m",
            "winch travel limits in encoder units");
-  t.number("max_payout", &PlannerOptions::max_payout_m, 1e9, kAnyNumber, "m", "");
-  t.number("max_sag_excess", &PlannerOptions::max_sag_excess, 0.02, kPositive, "",
+  t.number("max_payout", planner(&PlannerOptions::max_payout_m), 1e9, kAnyNumber, "m", "");
+  t.number("max_sag_excess", planner(&PlannerOptions::max_sag_excess), 0.02, kPositive, "",
            "(arc length - chord) / chord of every cable at most this");
-  t.choice("selection", &PlannerOptions::selection,
-           {{"spread", calibration::WaypointSelection::kSpread},
-            {"informative", calibration::WaypointSelection::kInformative}},
-           calibration::WaypointSelection::kSpread,
-           "evenly over the feasible candidates, or those that determine anchors and offsets best");
   return t;
 }
 
@@ -282,7 +298,7 @@ std::vector<Section> make_sections() {
   s.push_back(bind(pose_table(), [](auto& c) -> auto& { return c.pose; }));
   s.push_back(bind(button_table(), [](auto& c) -> auto& { return c.button; }));
   s.push_back(bind(limits_table(), [](auto& c) -> auto& { return c.calibrator; }));
-  s.push_back(bind(waypoints_table(), [](auto& c) -> auto& { return c.calibrator.planner; }));
+  s.push_back(bind(waypoints_table(), [](auto& c) -> auto& { return c.calibrator; }));
   s.push_back(bind(equilibrium_table(), [](auto& c) -> auto& { return c.calibrator; }));
   s.push_back(bind(solver_table(), [](auto& c) -> auto& { return c.solver; }));
   s.push_back(bind(validation_table(), [](auto& c) -> auto& { return c.calibrator.validation; }));

@@ -22,6 +22,19 @@ std::string utc_now_rfc3339() {
   return text;
 }
 
+namespace {
+
+// The calibrator's options with what other tables know: the sequential
+// strategy re-solves as the final solve does and times moves at the drives' profile speed.
+calibration::CalibratorOptions calibrator_options(const DaemonConfig& config) {
+  calibration::CalibratorOptions options = config.calibrator;
+  options.sequential.solver = config.solver;
+  options.sequential.winch_speed_mps = config.winches.drive.profile_velocity_mps;
+  return options;
+}
+
+}  // namespace
+
 DaemonLoop::DaemonLoop(const DaemonConfig& config, const Robot& robot, DaemonDevices devices,
                        store::CalibrationStore& store, const hal::Clock& clock, ServiceNotifier& notifier,
                        std::function<void(const std::string&)> log)
@@ -31,7 +44,7 @@ DaemonLoop::DaemonLoop(const DaemonConfig& config, const Robot& robot, DaemonDev
   machine_ = std::make_unique<calibration::CalibrationStateMachine>(
       robot_,
       calibration::CalibratorDevices{devices_.winches, devices_.load_cell, devices_.pose, devices_.button, store_},
-      config_.calibrator, calibration::SolveFunction{}, utc_now_rfc3339);
+      calibrator_options(config_), calibration::SolveFunction{}, utc_now_rfc3339);
   constexpr double kBytesPerMb = 1e6;
   std::optional<DiagnosisOptions> model_check;
   if (config_.history.model_check) {

@@ -52,6 +52,20 @@ FitSummary read_fit(TomlReader& reader, const toml::table& root) {
   return fit;
 }
 
+// [run]: written by the daemon; offline fits and older files have none.
+std::optional<RunSummary> read_run(TomlReader& reader, const toml::table& root) {
+  if (!root.contains("run")) return std::nullopt;
+  const toml::table& table = reader.table(root, "run", "");
+  reader.check_keys(table, "run",
+                    {{"robot_time", kRequired}, {"waypoints", kRequired}, {"strategy", kRequired}, {"stop", kRequired}});
+  RunSummary run;
+  run.robot_time_s = reader.number(table, "robot_time", "run", Bound::kNonNegative);
+  run.waypoints = reader.count(table, "waypoints", "run");
+  run.strategy = reader.string(table, "strategy", "run");
+  run.stop = reader.string(table, "stop", "run");
+  return run;
+}
+
 Calibration read_calibration(TomlReader& reader, const toml::table& root) {
   Calibration calibration;
 
@@ -71,7 +85,8 @@ Calibration read_calibration(TomlReader& reader, const toml::table& root) {
                      {"fit", kRequired},
                      {"effects", kOptional},
                      {"model_warning", kOptional},
-                     {"rejected", kOptional}});
+                     {"rejected", kOptional},
+                     {"run", kOptional}});
   calibration.format = static_cast<int>(format);
   calibration.created = reader.offset_date_time(root, "created", "");
   calibration.robot = reader.string(root, "robot", "");
@@ -82,6 +97,7 @@ Calibration read_calibration(TomlReader& reader, const toml::table& root) {
   calibration.fit = read_fit(reader, root);
   calibration.effects = read_effects(reader, root);
   calibration.rejected = read_sensor_readings(reader, root, "rejected", "residual");
+  calibration.run = read_run(reader, root);
   return calibration;
 }
 
@@ -135,6 +151,13 @@ std::string format_calibration_toml(const Calibration& calibration) {
   append_effects(out, calibration.effects);
   append_sensor_readings(out, calibration.rejected, "rejected", "residual",
                          "normalised residual [sigma] at the robust fit; left out of the final fit");
+  if (const std::optional<RunSummary>& run = calibration.run) {
+    out += "\n[run]\n";
+    append_line(out, "robot_time = " + toml_number(run->robot_time_s), "s, from the run's start to the fit");
+    append_line(out, "waypoints = " + std::to_string(run->waypoints), "visited: sampled or skipped");
+    append_line(out, "strategy = " + toml_string(run->strategy));
+    append_line(out, "stop = " + toml_string(run->stop), "why the waypoints ended");
+  }
   return out;
 }
 

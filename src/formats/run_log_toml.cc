@@ -21,7 +21,8 @@ RunLog read_run_log(TomlReader& reader, const toml::table& root) {
                     {{"format", Presence::kRequired}, {"run", Presence::kRequired}, {"outcome", Presence::kRequired},
                      {"reason", Presence::kOptional}, {"robot", Presence::kRequired}, {"started", Presence::kRequired},
                      {"finished", Presence::kOptional}, {"robot_time_s", Presence::kRequired},
-                     {"waypoints_planned", Presence::kRequired}, {"samples", Presence::kRequired},
+                     {"waypoints_planned", Presence::kRequired}, {"strategy", Presence::kOptional},
+                     {"stop", Presence::kOptional}, {"samples", Presence::kRequired},
                      {"skipped", Presence::kRequired}, {"calibration", Presence::kOptional},
                      {"diagnosis", Presence::kOptional}, {"refit_of", Presence::kOptional},
                      {"waypoint", Presence::kOptional},
@@ -44,6 +45,8 @@ RunLog read_run_log(TomlReader& reader, const toml::table& root) {
   if (root.contains("finished")) log.finished = reader.string(root, "finished", "");
   log.robot_time_s = reader.number(root, "robot_time_s", "", Bound::kNonNegative);
   log.waypoints_planned = reader.count(root, "waypoints_planned", "");
+  if (root.contains("strategy")) log.strategy = reader.string(root, "strategy", "");
+  if (root.contains("stop")) log.stop = reader.string(root, "stop", "");
   log.samples = reader.count(root, "samples", "");
   log.skipped = reader.count(root, "skipped", "");
   if (root.contains("calibration")) log.calibration = reader.count(root, "calibration", "");
@@ -87,7 +90,9 @@ std::string format_run_log_toml(const RunLog& log) {
   append_line(out, "started = " + toml_string(log.started), "UTC");
   if (!log.finished.empty()) append_line(out, "finished = " + toml_string(log.finished), "UTC");
   append_line(out, "robot_time_s = " + toml_number(log.robot_time_s), "from the start to the end of the run");
-  append_line(out, "waypoints_planned = " + std::to_string(log.waypoints_planned));
+  append_line(out, "waypoints_planned = " + std::to_string(log.waypoints_planned), "sequential: its max_count");
+  if (!log.strategy.empty()) append_line(out, "strategy = " + toml_string(log.strategy));
+  if (!log.stop.empty()) append_line(out, "stop = " + toml_string(log.stop), "why the waypoints ended");
   append_line(out, "samples = " + std::to_string(log.samples), "rows of samples.csv");
   append_line(out, "skipped = " + std::to_string(log.skipped), "waypoints without equilibrium");
   if (log.calibration > 0) append_line(out, "calibration = " + std::to_string(log.calibration), "history sequence number");

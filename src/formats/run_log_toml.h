@@ -29,7 +29,7 @@ struct RunWaypoint {
   std::string outcome;      // "sampled" or "skipped"
   double at_s = 0.0;        // robot time when it was sampled or given up
   int sample = -1;          // row id in samples.csv when sampled, else -1
-  std::string why;          // why it was skipped; empty when sampled
+  std::string why;          // why it was skipped; for a sampled one, a remark or empty
 };
 
 struct RunFault {
@@ -45,7 +45,9 @@ struct RunLog {
   std::string started;         // RFC 3339 UTC
   std::string finished;        // empty while running
   double robot_time_s = 0.0;   // from the start to the end (or to the last write while running)
-  int waypoints_planned = 0;
+  int waypoints_planned = 0;   // the fixed plan's size, or the sequential strategy's max_count
+  std::string strategy;        // "spread", "informative", "sequential"; empty before planning (and in old files)
+  std::string stop;            // why the waypoints ended; empty while they go on (and in old files)
   int samples = 0;
   int skipped = 0;
   int calibration = 0;         // store sequence number committed by this run; 0 none

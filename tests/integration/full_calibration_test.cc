@@ -4,6 +4,9 @@
 // within 0.10 m of the virtual robot's truth, and status is answered within
 // 100 ms all along. The run's data is kept in its history entry, and
 // `cdpr-calib solve <entry>` reproduces the committed anchors from it.
+// The sequential strategy on the same robot: it stops at its targets with
+// fewer waypoints than the fixed plan, and its anchors are within 3 x the
+// target of the truth.
 
 #include <chrono>
 #include <cstdlib>
@@ -102,6 +105,67 @@ TEST(FullCalibration, LargeRobotWith35WaypointsFindsTheAnchorsWithin10cm) {
     std::printf("cable %d: re-solved anchor from the history entry moved %.2e m\n", i, moved_m);
     EXPECT_LT(moved_m, 1e-3) << "cable " << i;
   }
+  rig.keep_dir = ::testing::Test::HasFailure();
+}
+
+TEST(FullCalibration, LargeRobotSequentialReachesTheTargetWithFewerWaypoints) {
+  // GIVEN the same virtual robot and the daemon set to the sequential strategy (default targets)
+  VirtualRobotRig rig(large_robot_acceptance_options(), [](VirtualRobotRig& r) {
+    r.config.calibrator.strategy = calibration::WaypointStrategy::kSequential;
+  });
+  const double target_m = rig.config.calibrator.sequential.target_anchor_sigma_m;
+  const int spread_count = rig.config.calibrator.planner.waypoint_count;
+
+  // WHEN the operator starts a calibration and it runs to its end
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  ASSERT_TRUE(rig.ask("start")["ok"].boolean());
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(5);
+  calibctl::JsonValue status;
+  bool saw_sigma = false, saw_time_left = false;
+  do {
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    status = rig.ask("status");
+    saw_sigma = saw_sigma || !status["sigma"].is_null();
+    saw_time_left = saw_time_left || !status["time_left_s"].is_null();
+  } while (status["running"].boolean() && std::chrono::steady_clock::now() < deadline);
+  rig.loop->wait_for_history();
+  rig.stop_daemon();
+  rig.keep_dir = true;
+
+  // THEN it committed, the waypoints ended by the stop rule with fewer samples than the fixed plan
+  ASSERT_EQ(status["state"].string(), "done") << status["reason"].string() << " (in " << rig.dir << ")";
+  EXPECT_EQ(status["strategy"].string(), "sequential");
+  const auto current = rig.store->load_current();
+  ASSERT_TRUE(current && current->has_value());
+  const Calibration& calibration = (*current)->calibration;
+  ASSERT_TRUE(calibration.run.has_value());
+  std::printf("sequential: %d waypoints (%d samples), robot time %.1f s, stop: %s; largest sigma anchor %.4f m, "
+              "offset %.4f m\n",
+              calibration.run->waypoints, calibration.samples, calibration.run->robot_time_s,
+              calibration.run->stop.c_str(), status["sigma"]["anchor"].number(), status["sigma"]["offset"].number());
+  EXPECT_EQ(calibration.run->strategy, "sequential");
+  EXPECT_EQ(calibration.run->stop, "target reached");
+  EXPECT_LT(calibration.samples, spread_count);
+  EXPECT_GT(calibration.run->robot_time_s, 0.0);
+  // AND status showed the sigmas against the target and an estimate of the time left while it ran
+  EXPECT_TRUE(saw_sigma);
+  EXPECT_TRUE(saw_time_left);
+  // AND every anchor is within 3 x the target of the truth
+  const Truth& truth = rig.robot->truth();
+  for (int i = 0; i < kCableCount; ++i) {
+    const double error_m = (calibration.winches[i].anchor_world - truth.winches[i].anchor_world).norm();
+    const double offset_error_m = calibration.winches[i].offset_m - truth.winches[i].offset_m;
+    std::printf("cable %d: anchor error %.4f m (sigma %.4f, %.4f, %.4f), offset error %+.4f m\n", i, error_m,
+                calibration.winches[i].anchor_sigma.x(), calibration.winches[i].anchor_sigma.y(),
+                calibration.winches[i].anchor_sigma.z(), offset_error_m);
+    EXPECT_LT(error_m, 3.0 * target_m) << "cable " << i;
+  }
+  // AND the run log records the strategy and why the waypoints ended
+  const auto log = formats::read_run_log_toml(rig.config.store.state_dir + "/history/run-000001/" +
+                                              store::RunHistory::kLogName);
+  ASSERT_TRUE(log) << log.error().message();
+  EXPECT_EQ(log->strategy, "sequential");
+  EXPECT_EQ(log->stop, "target reached");
   rig.keep_dir = ::testing::Test::HasFailure();
 }
 

@@ -33,6 +33,21 @@ void append_refit_hint(std::string& out, const JsonValue& run) {
          (name.empty() ? "" : " " + name) + "\n";
 }
 
+// "robot time 412.3 s, about 180 s left; largest sigma: anchor 0.031 m (target 0.02), offset ..."
+std::string waypoint_progress(const JsonValue& s) {
+  if (s["strategy"].string().empty()) return "";
+  std::string out = "  " + s["strategy"].string();
+  if (!s["elapsed_s"].is_null()) out += format(": robot time %.1f s", s["elapsed_s"].number());
+  if (!s["time_left_s"].is_null()) out += format(", about %.0f s left", s["time_left_s"].number());
+  if (!s["stop_reason"].string().empty()) out += " (waypoints ended: " + s["stop_reason"].string() + ")";
+  if (const JsonValue sigma = s["sigma"]; !sigma.is_null()) {
+    out += format("; largest sigma: anchor %.4f m (target %.4g), offset %.4f m (target %.4g)",
+                  sigma["anchor"].number(), sigma["target_anchor"].number(), sigma["offset"].number(),
+                  sigma["target_offset"].number());
+  }
+  return out + "\n";
+}
+
 }  // namespace
 
 std::string render_refit(const JsonValue& refit) {
@@ -53,6 +68,7 @@ std::string render_status(const JsonValue& s) {
   out += format("  %.0f%%", 100.0 * s["progress"].number());
   if (!s["elapsed_s"].is_null()) out += format("  %.1f s", s["elapsed_s"].number());
   out += "\n";
+  out += waypoint_progress(s);
   append_if(out, "detail", s["detail"]);
   append_if(out, "note", s["note"]);
   append_if(out, "faults", s["device_faults"]);

@@ -147,11 +147,7 @@ class CalibrationRig {
     return sample;
   }
 
-  const Waypoint* current_waypoint() const {
-    const int k = active->status().waypoint;
-    if (k < 1 || k > static_cast<int>(active->plan().waypoints.size())) return nullptr;
-    return &active->plan().waypoints[k - 1];
-  }
+  const Waypoint* current_waypoint() const { return active->current_waypoint(); }
 
   // The load cell reads the modelled tension of the reference cable at the
   // current waypoint, so samples are consistent with the catenary model.

@@ -4,6 +4,8 @@
 
 #include "src/calibration/calibration_state_machine.h"
 
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
 #include "calibration_rig.h"
@@ -66,6 +68,50 @@ TEST(CalibrationStateMachine, SamplesAreTheRestPosesAndEncoders) {
     EXPECT_DOUBLE_EQ(samples[k].force_n, 300.0);
     EXPECT_EQ(samples[k].id, static_cast<int>(k));
   }
+}
+
+TEST(CalibrationStateMachine, TheSequentialStrategyChoosesWaypointsUntilItsStopRule) {
+  // GIVEN the sequential strategy, at most 8 samples, consistent tensions
+  CalibratorOptions options = test::rig_options();
+  options.strategy = WaypointStrategy::kSequential;
+  options.sequential.max_count = 8;
+  CalibrationRig rig(options);
+  rig.use_model_tension();
+  // WHEN a run goes to the end
+  ASSERT_TRUE(rig.machine->request_start(rig.clock.now_us()));
+  ASSERT_TRUE(rig.run_until([&] { return rig.status().state == CalibrationState::kSettle; }));
+  // THEN while it runs, the status names the strategy and the targets
+  EXPECT_EQ(rig.status().strategy, "sequential");
+  EXPECT_EQ(rig.status().waypoint_count, 8);
+  EXPECT_DOUBLE_EQ(rig.status().target_anchor_sigma_m, 0.02);
+  ASSERT_TRUE(rig.run_to_end());
+  // AND it commits, having stopped by its rule after at least the rows validation needs
+  EXPECT_EQ(rig.status().state, CalibrationState::kDone) << rig.status().reason;
+  EXPECT_FALSE(rig.status().stop_reason.empty());
+  EXPECT_GE(rig.status().samples, options.validation.min_samples);
+  EXPECT_LE(rig.status().samples, 8);
+  EXPECT_GT(rig.status().largest_anchor_sigma_m, 0.0);
+  // AND every sample is one candidate's rest pose, none twice
+  std::vector<int> seen;
+  for (const Sample& sample : rig.machine->samples()) {
+    int match = -1;
+    const auto& candidates = rig.machine->plan().waypoints;
+    for (std::size_t k = 0; k < candidates.size(); ++k) {
+      if ((sample.position_world - candidates[k].rest.world_T_platform.position_world).norm() < 1e-9) match = static_cast<int>(k);
+    }
+    ASSERT_GE(match, 0);
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), match), 0);
+    seen.push_back(match);
+  }
+  // AND calibration.toml and the run log say how the run went
+  const auto current = rig.store.load_current();
+  ASSERT_TRUE(current && current->has_value());
+  ASSERT_TRUE((*current)->calibration.run.has_value());
+  EXPECT_EQ((*current)->calibration.run->strategy, "sequential");
+  EXPECT_EQ((*current)->calibration.run->waypoints, rig.status().samples);
+  EXPECT_EQ((*current)->calibration.run->stop, rig.status().stop_reason);
+  EXPECT_EQ(rig.machine->run_log().strategy, "sequential");
+  EXPECT_EQ(rig.machine->run_log().stop, rig.status().stop_reason);
 }
 
 TEST(CalibrationStateMachine, EncoderNodeSilentStopsTheRun) {

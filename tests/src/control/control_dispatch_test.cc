@@ -24,7 +24,8 @@ TEST(ControlDispatch, StatusOfAnIdleDaemon) {
   CalibrationRig rig;
   EXPECT_EQ(ask(rig, "status"),
             "{\"ok\":true,\"state\":\"idle\",\"running\":false,\"waypoint\":0,\"waypoints\":0,\"samples\":0,"
-            "\"skipped\":0,\"progress\":0,\"elapsed_s\":null,\"reason\":\"\",\"note\":\"\",\"detail\":\"\","
+            "\"skipped\":0,\"progress\":0,\"elapsed_s\":null,\"strategy\":\"\",\"stop_reason\":\"\",\"sigma\":null,"
+            "\"time_left_s\":null,\"reason\":\"\",\"note\":\"\",\"detail\":\"\","
             "\"device_faults\":\"\",\"committed_seq\":0,\"interrupted\":\"\",\"store_problems\":[],\"pending_commit\":false,"
             "\"run\":null,\"refit\":null}\n");
 }

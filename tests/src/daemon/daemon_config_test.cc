@@ -54,7 +54,8 @@ TEST(DaemonConfig, TheShippedExampleParsesToTheDefaults) {
   EXPECT_EQ(p.margin_m, defaults.calibrator.planner.margin_m);
   EXPECT_EQ(p.z_max_m, defaults.calibrator.planner.z_max_m);
   EXPECT_EQ(p.max_tension_n, defaults.calibrator.planner.max_tension_n);
-  EXPECT_EQ(p.selection, defaults.calibrator.planner.selection);
+  EXPECT_EQ(config->calibrator.strategy, defaults.calibrator.strategy);
+  EXPECT_EQ(config->calibrator.sequential.max_count, defaults.calibrator.sequential.max_count);
   EXPECT_EQ(config->calibrator.settle_timeout_us, defaults.calibrator.settle_timeout_us);
   EXPECT_EQ(config->calibrator.first_contact_timeout_us, defaults.calibrator.first_contact_timeout_us);
   EXPECT_EQ(config->calibrator.enable_timeout_us, defaults.calibrator.enable_timeout_us);
@@ -91,7 +92,10 @@ kind = "none"
 [equilibrium]
 window_s = 1.5
 [waypoints]
-selection = "informative"
+strategy = "sequential"
+target_anchor_sigma = 0.01
+target_offset_sigma = 0.015
+max_count = 40
 [limits]
 first_contact_timeout_s = 0.5
 [validation]
@@ -121,7 +125,10 @@ accept_max_iterations = true
   EXPECT_EQ(config->load_cell.fault_timeout_us, 400'000);
   EXPECT_FALSE(config->button.gpio);
   EXPECT_EQ(config->calibrator.equilibrium.window_us, 1'500'000);
-  EXPECT_EQ(config->calibrator.planner.selection, calibration::WaypointSelection::kInformative);
+  EXPECT_EQ(config->calibrator.strategy, calibration::WaypointStrategy::kSequential);
+  EXPECT_EQ(config->calibrator.sequential.target_anchor_sigma_m, 0.01);
+  EXPECT_EQ(config->calibrator.sequential.target_offset_sigma_m, 0.015);
+  EXPECT_EQ(config->calibrator.sequential.max_count, 40);
   EXPECT_EQ(config->calibrator.first_contact_timeout_us, 500'000);
   EXPECT_TRUE(config->calibrator.validation.accept_max_iterations);
 }
@@ -141,7 +148,9 @@ TEST(DaemonConfig, RefusesBadInputNamingLineAndKey) {
       {"robot = \"r\"\n[load_cell]\nbyte_order = \"ADCB\"\n", 3, "load_cell.byte_order"},
       {"robot = \"r\"\n[load_cell]\nstatus_address = 1\n", 3, "load_cell.status_address"},  // overlaps the value
       {"robot = \"r\"\n[button]\nkind = \"gpoi\"\n", 3, "button.kind"},                    // not a choice
-      {"robot = \"r\"\n[waypoints]\nselection = \"optimal\"\n", 3, "waypoints.selection"},  // not a choice
+      {"robot = \"r\"\n[waypoints]\nstrategy = \"optimal\"\n", 3, "waypoints.strategy"},  // not a choice
+      {"robot = \"r\"\n[waypoints]\nstrategy = \"sequential\"\nmax_count = 5\n", 4,
+       "waypoints.max_count"},  // fewer than validation.min_samples
       {"robot = \"r\"\n[loop]\nperiod_ms = -5\n", 3, "loop.period_ms"},                    // not positive
       {"robot = \"r\"\n[button]\nactive_low = 1\n", 3, "button.active_low"},               // not a bool
       {"[store]\nstate_dir = \"/x\"\n", 0, "robot"},                                        // missing required

@@ -195,6 +195,29 @@ TEST(CalibrationToml, EmptyModelListRoundTrips) {
   EXPECT_TRUE(again->model.empty());
 }
 
+TEST(CalibrationToml, TheDaemonsRunSummaryRoundTripsAndOldFilesHaveNone) {
+  // GIVEN a file without [run] (older files, offline fits)
+  auto calibration = parse_calibration_toml(kExample, "calibration.toml");
+  ASSERT_TRUE(calibration.has_value());
+  // THEN it reads, with no run summary, and is written without one
+  EXPECT_FALSE(calibration->run.has_value());
+  EXPECT_EQ(format_calibration_toml(*calibration).find("[run]"), std::string::npos);
+  // GIVEN the daemon's run summary WHEN formatted and parsed again THEN it is the same
+  calibration->run = RunSummary{412.5 + 1.0 / 3.0, 19, "sequential", "target reached"};
+  const std::string text = format_calibration_toml(*calibration);
+  const auto again = parse_calibration_toml(text, "written.toml");
+  ASSERT_TRUE(again.has_value()) << again.error().message() << "\n" << text;
+  ASSERT_TRUE(again->run.has_value());
+  EXPECT_EQ(again->run->robot_time_s, calibration->run->robot_time_s);
+  EXPECT_EQ(again->run->waypoints, 19);
+  EXPECT_EQ(again->run->strategy, "sequential");
+  EXPECT_EQ(again->run->stop, "target reached");
+  // AND a [run] missing a key is refused naming it
+  const auto partial = parse_calibration_toml(test::replaced(text, "stop = ", "stopped = "), "partial.toml");
+  ASSERT_FALSE(partial.has_value());
+  EXPECT_NE(partial.error().message().find("run."), std::string::npos) << partial.error().message();
+}
+
 TEST(CalibrationTomlDeathTest, FormatRefusesACreatedThatIsNoDateTime) {
   // GIVEN a calibration whose `created` is not a date-time
   Calibration calibration;

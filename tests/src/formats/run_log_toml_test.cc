@@ -18,11 +18,13 @@ RunLog example_log() {
   log.finished = "2026-11-26T10:14:02Z";
   log.robot_time_s = 842.25;
   log.waypoints_planned = 35;
+  log.strategy = "sequential";
+  log.stop = "target reached";
   log.samples = 33;
   log.skipped = 2;
   log.calibration = 3;
   log.diagnosis = "model explains the data";
-  log.waypoints.push_back({1, "sampled", 20.5, 0, ""});
+  log.waypoints.push_back({1, "sampled", 20.5, 0, "re-solve with 11 samples failed: next waypoint in spread order"});
   log.waypoints.push_back({2, "skipped", 85.0, -1, "no equilibrium within 60 s (platform moving: 4.1 mm/s)"});
   log.faults.push_back({90.0, "winch 2: \"heartbeat\" lost"});
   return log;
@@ -40,7 +42,10 @@ TEST(RunLogToml, WhatIsWrittenReadsBackTheSame) {
   EXPECT_EQ(parsed->robot_time_s, 842.25);
   EXPECT_EQ(parsed->calibration, 3);
   EXPECT_EQ(parsed->diagnosis, log.diagnosis);
+  EXPECT_EQ(parsed->strategy, "sequential");
+  EXPECT_EQ(parsed->stop, "target reached");
   ASSERT_EQ(parsed->waypoints.size(), 2u);
+  EXPECT_EQ(parsed->waypoints[0].why, log.waypoints[0].why);
   EXPECT_EQ(parsed->waypoints[0].sample, 0);
   EXPECT_EQ(parsed->waypoints[1].sample, -1);
   EXPECT_EQ(parsed->waypoints[1].why, log.waypoints[1].why);
