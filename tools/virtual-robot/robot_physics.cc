@@ -109,11 +109,10 @@ void RobotPhysics::advance(double dt_s) {
   Eigen::Vector3d r = so3_log(rest_r.conjugate() * pose_.world_R_platform);
   sway_step(omega_radps_, zeta, dt_s, r, angular_velocity_radps_);
   pose_.world_R_platform = (rest_r * so3_exp(r)).normalized();
-  for (int i = 0; i < kCableCount; ++i) {
-    double t = tension_n_[i] - rest_.cables[i].tension_n;
-    sway_step(omega_radps_, zeta, dt_s, t, tension_rate_nps_[i]);
-    tension_n_[i] = rest_.cables[i].tension_n + t;
-  }
+  // Tensions approach their rest values with a first-order lag: an
+  // oscillator of its own would swing a cable's tension below zero.
+  const double a = 1.0 - std::exp(-dt_s / options_.tension_time_constant_s);
+  for (int i = 0; i < kCableCount; ++i) tension_n_[i] += a * (rest_.cables[i].tension_n - tension_n_[i]);
 }
 
 double RobotPhysics::natural_frequency_radps() const {

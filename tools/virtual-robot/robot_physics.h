@@ -8,8 +8,7 @@
 // platform on long cables does.
 //
 // Sway: every coordinate of the platform's deviation from the rest state
-// (position, rotation vector relative to the rest orientation, each cable's
-// tension) obeys  e'' + 2 zeta w e' + w^2 e = 0  towards the latest rest
+// (position, rotation vector relative to the rest orientation) obeys  e'' + 2 zeta w e' + w^2 e = 0  towards the latest rest
 // state, integrated exactly for any step length. w comes from the cables'
 // geometric stiffness at the rest pose, K = sum_i T_i / L_i (I - u_i u_i^T)
 // (T_i tension, L_i and u_i chord length and direction): the horizontal
@@ -23,7 +22,8 @@
 // the attachment + true encoder offset_i (docs/FORMATS.md enc_i). The
 // equilibrium is recomputed whenever the cables have moved, at most every
 // equilibrium_interval_s of simulated time; between solves the platform
-// sways about the latest equilibrium (pose and cable tensions alike).
+// sways about the latest equilibrium; the cable tensions follow theirs with
+// a first-order lag of tension_time_constant_s.
 // Time: simulated seconds passed to advance(); no clock read here.
 // Not thread-safe.
 
@@ -42,6 +42,7 @@ namespace cdpr::virtual_robot {
 struct PhysicsOptions {
   double damping_ratio = 0.05;           // zeta of the sway (light damping)
   double sway_period_s = 0.0;            // > 0: sway period [s]; 0: from the cable geometry
+  double tension_time_constant_s = 0.2;  // tensions' approach to their rest values [s]
   double winch_speed_mps = 2.0;          // profile velocity of every drive [m/s]
   double equilibrium_interval_s = 0.05;  // least simulated time between equilibrium solves [s]
   int segments = 200;                    // Simpson segments per cable (sim/cable_shooting.h)
@@ -93,7 +94,6 @@ class RobotPhysics {
   Pose pose_;
   Eigen::Vector3d velocity_mps_ = Eigen::Vector3d::Zero();       // [m/s, world]
   Eigen::Vector3d angular_velocity_radps_ = Eigen::Vector3d::Zero();  // of the rotation vector [rad/s]
-  std::array<double, kCableCount> tension_rate_nps_{};           // [N/s]
   double omega_radps_ = 1.0;  // natural_frequency_radps() of rest_
   std::array<double, kCableCount> tension_n_{};
   std::array<double, kCableCount> payout_m_{};
