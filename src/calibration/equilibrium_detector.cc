@@ -3,6 +3,11 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
+#include <numbers>
+#include <span>
+
+#include <Eigen/Cholesky>
 
 #include "solver/nls/pose.h"
 #include "src/calibration/window_statistics.h"
@@ -17,16 +22,25 @@ const char* to_string(EquilibriumVerdict verdict) {
     case EquilibriumVerdict::kMoving: return "platform moving";
     case EquilibriumVerdict::kRotating: return "platform rotating";
     case EquilibriumVerdict::kSettled: return "settled";
+    case EquilibriumVerdict::kSwayEstimated: return "rest estimated from the sway";
   }
   return "unknown";
 }
 
 EquilibriumDetector::EquilibriumDetector(const EquilibriumThresholds& thresholds, std::size_t capacity)
-    : thresholds_(thresholds), ring_(std::max<std::size_t>(capacity, 2)), scratch_(ring_.size()) {}
+    : thresholds_(thresholds),
+      ring_(std::max<std::size_t>(capacity, 2)),
+      scratch_(ring_.size()),
+      bins_(kSwayBins),
+      values_(ring_.size()),
+      basis_(ring_.size()) {}
 
 void EquilibriumDetector::reset() {
   first_ = 0;
   count_ = 0;
+  added_ = 0;
+  sway_ = SwayFit{};
+  last_check_sway_ = false;
 }
 
 const EquilibriumObservation& EquilibriumDetector::at(std::size_t k) const {
@@ -41,9 +55,13 @@ void EquilibriumDetector::add(const EquilibriumObservation& observation) {
   }
   ring_[(first_ + count_) % ring_.size()] = observation;
   ++count_;
-  // Keep exactly one observation at or before the window's start, so a full
-  // window is recognisable by its span, and at least min_samples.
-  const hal::TimeUs window_start_us = observation.time_us - thresholds_.window_us;
+  ++added_;
+  // Keep exactly one observation at or before the start of the longer of
+  // the rest and the sway window, so a full window is recognisable by its
+  // span, and at least min_samples.
+  const hal::TimeUs window_start_us =
+      observation.time_us -
+      (thresholds_.estimate_sway ? std::max(thresholds_.window_us, thresholds_.sway_window_us) : thresholds_.window_us);
   const std::size_t keep = static_cast<std::size_t>(std::max({2, thresholds_.min_samples, kRateBins}));
   while (count_ > keep && at(1).time_us <= window_start_us) {
     first_ = (first_ + 1) % ring_.size();
@@ -51,13 +69,22 @@ void EquilibriumDetector::add(const EquilibriumObservation& observation) {
   }
 }
 
-Eigen::Quaterniond EquilibriumDetector::mean_orientation() const {
+std::size_t EquilibriumDetector::window_begin() const {
+  if (count_ == 0) return 0;
+  const hal::TimeUs start_us = at(count_ - 1).time_us - thresholds_.window_us;
+  std::size_t begin = 0;
+  while (begin + 1 < count_ && at(begin + 1).time_us <= start_us) ++begin;
+  const std::size_t keep = static_cast<std::size_t>(std::max({2, thresholds_.min_samples, kRateBins}));
+  return count_ > keep ? std::min(begin, count_ - keep) : 0;
+}
+
+Eigen::Quaterniond EquilibriumDetector::mean_orientation(std::size_t begin) const {
   // Sign-aligned mean of the coefficients: q and -q are the same rotation,
   // and for the small spread of a resting platform the normalized mean is the
   // rotation average to first order.
-  const Eigen::Vector4d reference = at(0).world_R_platform.coeffs();
+  const Eigen::Vector4d reference = at(begin).world_R_platform.coeffs();
   Eigen::Vector4d sum = Eigen::Vector4d::Zero();
-  for (std::size_t k = 0; k < count_; ++k) {
+  for (std::size_t k = begin; k < count_; ++k) {
     const Eigen::Vector4d q = at(k).world_R_platform.coeffs();
     sum += q.dot(reference) < 0.0 ? Eigen::Vector4d(-q) : q;
   }
@@ -68,29 +95,32 @@ Eigen::Quaterniond EquilibriumDetector::mean_orientation() const {
 
 EquilibriumCheck EquilibriumDetector::check() const {
   EquilibriumCheck result;
-  result.samples = static_cast<int>(count_);
-  if (count_ < 2) return result;
-  const hal::TimeUs start_us = at(0).time_us;
+  last_check_sway_ = false;
+  const std::size_t begin = window_begin();
+  const std::size_t n = count_ - begin;
+  result.samples = static_cast<int>(n);
+  if (n < 2) return result;
+  const hal::TimeUs start_us = at(begin).time_us;
   result.span_us = at(count_ - 1).time_us - start_us;
 
   // Tension mean and standard deviation; stable bits.
   double tension_sum = 0.0;
   bool all_stable = true;
-  for (std::size_t k = 0; k < count_; ++k) {
+  for (std::size_t k = begin; k < count_; ++k) {
     tension_sum += at(k).tension_n;
     all_stable = all_stable && at(k).tension_stable;
   }
-  const double tension_mean = tension_sum / static_cast<double>(count_);
+  const double tension_mean = tension_sum / static_cast<double>(n);
   double square_sum = 0.0;
-  for (std::size_t k = 0; k < count_; ++k) square_sum += std::pow(at(k).tension_n - tension_mean, 2);
-  result.tension_std_n = std::sqrt(square_sum / static_cast<double>(count_ - 1));
+  for (std::size_t k = begin; k < count_; ++k) square_sum += std::pow(at(k).tension_n - tension_mean, 2);
+  result.tension_std_n = std::sqrt(square_sum / static_cast<double>(n - 1));
 
   // Bin means of position (relative to the oldest, against cancellation) and
   // of the rotation relative to the mean orientation; the noise of one
   // observation from successive differences, which a slow motion hardly
   // enters (half their mean square is the noise variance of white noise).
-  const Eigen::Quaterniond mean_q = mean_orientation();
-  const Eigen::Vector3d origin = at(0).position_world;
+  const Eigen::Quaterniond mean_q = mean_orientation(begin);
+  const Eigen::Vector3d origin = at(begin).position_world;
   std::array<Eigen::Vector3d, kRateBins> position_sum, rotation_sum;
   std::array<double, kRateBins> time_sum{};
   std::array<int, kRateBins> bin_count{};
@@ -99,14 +129,14 @@ EquilibriumCheck EquilibriumDetector::check() const {
   Eigen::Vector3d position_step_square = Eigen::Vector3d::Zero(), rotation_step_square = Eigen::Vector3d::Zero();
   Eigen::Vector3d previous_p = Eigen::Vector3d::Zero(), previous_r = Eigen::Vector3d::Zero();
   const double span = std::max<double>(static_cast<double>(result.span_us), 1.0);
-  for (std::size_t k = 0; k < count_; ++k) {
+  for (std::size_t k = begin; k < count_; ++k) {
     const EquilibriumObservation& o = at(k);
     const int bin = std::min(kRateBins - 1, static_cast<int>(kRateBins * (o.time_us - start_us) / span));
     const Eigen::Vector3d p = o.position_world - origin;
     const Eigen::Vector3d r = so3_log(mean_q.conjugate() * o.world_R_platform);
     position_sum[bin] += p;
     rotation_sum[bin] += r;
-    if (k > 0) {
+    if (k > begin) {
       position_step_square += (p - previous_p).cwiseAbs2();
       rotation_step_square += (r - previous_r).cwiseAbs2();
     }
@@ -119,7 +149,7 @@ EquilibriumCheck EquilibriumDetector::check() const {
   for (int b = 0; b < kRateBins; ++b) bins_filled = bins_filled && bin_count[b] > 0;
   if (bins_filled) {
     // Per-axis noise variance of one observation.
-    const double steps = 2.0 * static_cast<double>(count_ - 1);
+    const double steps = 2.0 * static_cast<double>(n - 1);
     const Eigen::Vector3d position_var = position_step_square / steps;
     const Eigen::Vector3d rotation_var = rotation_step_square / steps;
     for (int b = 0; b + 1 < kRateBins; ++b) {
@@ -150,23 +180,220 @@ EquilibriumCheck EquilibriumDetector::check() const {
   } else {
     result.verdict = EquilibriumVerdict::kSettled;
   }
+  // Only a platform seen moving is tried as a sway: one at rest whose load
+  // cell is not stable or whose tension varies stays refused.
+  const bool moving = !(result.speed_mps <= thresholds_.max_speed_mps) ||
+                      !(result.angular_rate_radps <= thresholds_.max_angular_rate_radps);
+  if (result.verdict != EquilibriumVerdict::kSettled && result.verdict != EquilibriumVerdict::kNotEnoughData &&
+      moving && thresholds_.estimate_sway) {
+    fit_sway();
+    result.sway_period_s = sway_.omega_radps > 0.0 ? 2.0 * std::numbers::pi / sway_.omega_radps : 0.0;
+    result.sway_misfit = sway_.misfit;
+    if (sway_.accepted) {
+      result.verdict = EquilibriumVerdict::kSwayEstimated;
+      last_check_sway_ = true;
+    }
+  }
   return result;
+}
+
+double EquilibriumDetector::coordinate(const EquilibriumObservation& o, int c, const Eigen::Quaterniond& mean_q) const {
+  if (c < 3) return o.position_world(c);
+  if (c < 6) return so3_log(mean_q.conjugate() * o.world_R_platform)(c - 3);
+  if (c < 6 + kCableCount) return o.encoder_m[c - 6];
+  return o.tension_n;
+}
+
+double EquilibriumDetector::sway_residual_sum(double omega, double decay) const {
+  // Least squares of the bin means (weighted by their counts) on
+  // 1, exp(-decay t) cos(omega t), exp(-decay t) sin(omega t), per axis.
+  Eigen::Matrix3d gram = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d rhs = Eigen::Matrix3d::Zero();  // column per axis
+  double square_sum = 0.0;
+  for (const std::array<double, 5>& bin : bins_) {
+    const double w = bin[4];
+    if (w == 0.0) continue;
+    const double envelope = std::exp(-decay * bin[0]);
+    const Eigen::Vector3d phi(1.0, envelope * std::cos(omega * bin[0]), envelope * std::sin(omega * bin[0]));
+    gram += w * phi * phi.transpose();
+    for (int axis = 0; axis < 3; ++axis) {
+      rhs.col(axis) += w * bin[1 + axis] * phi;
+      square_sum += w * bin[1 + axis] * bin[1 + axis];
+    }
+  }
+  const Eigen::LDLT<Eigen::Matrix3d> solve(gram);
+  if (solve.info() != Eigen::Success) return square_sum;
+  double explained = 0.0;
+  for (int axis = 0; axis < 3; ++axis) explained += rhs.col(axis).dot(solve.solve(rhs.col(axis)));
+  return square_sum - explained;
+}
+
+void EquilibriumDetector::fit_sway() const {
+  if (sway_.newest_us >= 0 && added_ - sway_.added_at < static_cast<std::size_t>(kSwayRefitObservations)) return;
+  sway_ = SwayFit{};
+  const hal::TimeUs newest_us = at(count_ - 1).time_us;
+  sway_.newest_us = newest_us;
+  sway_.added_at = added_;
+
+  // The sway window: the last sway_window_us, at least min_samples.
+  std::size_t begin = 0;
+  while (begin + 1 < count_ && at(begin + 1).time_us <= newest_us - thresholds_.sway_window_us) ++begin;
+  const std::size_t keep = static_cast<std::size_t>(std::max({3 * kMinSamplesPerPeriod, thresholds_.min_samples}));
+  if (count_ < keep) return;
+  begin = std::min(begin, count_ - keep);
+  const std::size_t n = count_ - begin;
+  const hal::TimeUs t0_us = at(begin).time_us;
+  const double span_s = 1e-6 * static_cast<double>(newest_us - t0_us);
+  if (newest_us - t0_us < thresholds_.sway_window_us || !(span_s > 0.0)) return;
+  const double omega_min = 2.0 * std::numbers::pi * kMinSwayPeriods / span_s;
+  const double omega_max = 2.0 * std::numbers::pi * static_cast<double>(n - 1) / (kMinSamplesPerPeriod * span_s);
+  if (!(omega_max > 1.5 * omega_min)) return;
+
+  // Bin means of the position (relative to the oldest) for the search.
+  const Eigen::Vector3d origin = at(begin).position_world;
+  const int bin_count = static_cast<int>(std::min<std::size_t>(n, kSwayBins));
+  bins_.assign(bins_.size(), {0.0, 0.0, 0.0, 0.0, 0.0});
+  for (std::size_t k = begin; k < count_; ++k) {
+    const double t = 1e-6 * static_cast<double>(at(k).time_us - t0_us);
+    const int b = std::min(bin_count - 1, static_cast<int>(bin_count * t / span_s));
+    const Eigen::Vector3d p = at(k).position_world - origin;
+    bins_[b][0] += t;
+    for (int axis = 0; axis < 3; ++axis) bins_[b][1 + axis] += p(axis);
+    bins_[b][4] += 1.0;
+  }
+  for (std::array<double, 5>& bin : bins_) {
+    if (bin[4] > 0.0) {
+      for (int j = 0; j < 4; ++j) bin[j] /= bin[4];
+    }
+  }
+
+  // Grid over omega (log-spaced) and the decay (up to e^-4 over the window),
+  // then golden-section refinement of each in turn.
+  constexpr int kOmegaGrid = 48;
+  const double ratio = std::pow(omega_max / omega_min, 1.0 / (kOmegaGrid - 1));
+  const std::array<double, 6> decays{0.0, 0.25 / span_s, 0.5 / span_s, 1.0 / span_s, 2.0 / span_s, 4.0 / span_s};
+  double best = std::numeric_limits<double>::infinity(), omega = omega_min, decay = 0.0;
+  for (int i = 0; i < kOmegaGrid; ++i) {
+    const double w = omega_min * std::pow(ratio, i);
+    for (const double d : decays) {
+      const double r = sway_residual_sum(w, d);
+      if (r < best) {
+        best = r;
+        omega = w;
+        decay = d;
+      }
+    }
+  }
+  const auto golden = [](auto&& f, double lo, double hi) {
+    constexpr double kInv = 0.6180339887498949;
+    double a = hi - kInv * (hi - lo), b = lo + kInv * (hi - lo);
+    double fa = f(a), fb = f(b);
+    for (int iteration = 0; iteration < 40; ++iteration) {
+      if (fa < fb) {
+        hi = b;
+        b = a;
+        fb = fa;
+        a = hi - kInv * (hi - lo);
+        fa = f(a);
+      } else {
+        lo = a;
+        a = b;
+        fa = fb;
+        b = lo + kInv * (hi - lo);
+        fb = f(b);
+      }
+    }
+    return 0.5 * (lo + hi);
+  };
+  for (int round = 0; round < 3; ++round) {
+    omega = golden([&](double w) { return sway_residual_sum(w, decay); }, omega / ratio, omega * ratio);
+    decay = golden([&](double d) { return sway_residual_sum(omega, d); }, std::max(0.0, decay - 1.0 / span_s),
+                   decay + 1.0 / span_s);
+  }
+  sway_.omega_radps = omega;
+  sway_.decay_per_s = decay;
+  if (!(omega > omega_min * ratio && omega < omega_max / ratio)) return;  // at the edge: no oscillation found
+
+  // Every coordinate on the full window: rest values, residuals, misfit.
+  sway_.mean_q = mean_orientation(begin);
+  Eigen::Matrix3d gram = Eigen::Matrix3d::Zero();
+  for (std::size_t k = begin; k < count_; ++k) {
+    const double t = 1e-6 * static_cast<double>(at(k).time_us - t0_us);
+    const double envelope = std::exp(-decay * t);
+    Eigen::Vector3d& phi = basis_[k - begin];
+    phi = Eigen::Vector3d(1.0, envelope * std::cos(omega * t), envelope * std::sin(omega * t));
+    gram += phi * phi.transpose();
+  }
+  const Eigen::LDLT<Eigen::Matrix3d> solve(gram);
+  if (solve.info() != Eigen::Success) return;
+  const double rest_factor = std::sqrt(std::max(solve.solve(Eigen::Vector3d::UnitX())(0), 0.0));
+  // Residual differences at a lag of 1/20 period: readings repeated between
+  // sensor updates are not counted as noiseless.
+  const double samples_per_period = static_cast<double>(n - 1) / span_s * 2.0 * std::numbers::pi / omega;
+  const std::size_t lag = std::max<std::size_t>(1, static_cast<std::size_t>(samples_per_period / 20.0));
+  const std::span<const double> residuals(scratch_.data(), n);
+  bool consistent = true;
+  double significance = 0.0;
+  for (int c = 0; c < kSwayCoordinates; ++c) {
+    const double y0 = coordinate(at(begin), c, sway_.mean_q);
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    for (std::size_t k = begin; k < count_; ++k) {
+      values_[k - begin] = coordinate(at(k), c, sway_.mean_q) - y0;
+      rhs += values_[k - begin] * basis_[k - begin];
+    }
+    const Eigen::Vector3d beta = solve.solve(rhs);
+    double square_sum = 0.0, lag_square_sum = 0.0, constant_sum = 0.0, constant_square_sum = 0.0;
+    for (std::size_t j = 0; j < n; ++j) {
+      const double y = values_[j];
+      const double r = y - beta.dot(basis_[j]);
+      scratch_[j] = r;
+      square_sum += r * r;
+      constant_sum += y;
+      constant_square_sum += y * y;
+      if (j >= lag) lag_square_sum += std::pow(r - scratch_[j - lag], 2);
+    }
+    const double variance = square_sum / static_cast<double>(n - 3);
+    const double noise = lag_square_sum / (2.0 * static_cast<double>(n - lag));
+    const double misfit =
+        noise > 0.0 ? variance / noise : (variance > 0.0 ? std::numeric_limits<double>::infinity() : 1.0);
+    sway_.misfit = std::max(sway_.misfit, misfit);
+    if (c < 6 && variance > 0.0) {
+      const double constant_residual = constant_square_sum - constant_sum * constant_sum / static_cast<double>(n);
+      significance = std::max(significance, 0.5 * (constant_residual - square_sum) / variance);
+    }
+    consistent = consistent && misfit <= thresholds_.max_sway_misfit;
+    sway_.rest[c] = y0 + beta(0);
+    sway_.scatter[c] = std::sqrt(variance);
+    // The residuals' correlation: n / n_eff (window_statistics.h).
+    const WindowStatistics statistics = window_statistics(residuals, std::max(sway_.scatter[c], 1e-300));
+    sway_.factor[c] = rest_factor * std::sqrt(static_cast<double>(n) / statistics.effective_count);
+  }
+  sway_.accepted = consistent && significance >= kMinSwaySignificance;
 }
 
 Sample EquilibriumDetector::average() const {
   assert(count_ > 0);
   Sample sample;
+  if (last_check_sway_) {
+    sample.position_world = Eigen::Vector3d(sway_.rest[0], sway_.rest[1], sway_.rest[2]);
+    sample.world_R_platform =
+        (sway_.mean_q * so3_exp(Eigen::Vector3d(sway_.rest[3], sway_.rest[4], sway_.rest[5]))).normalized();
+    for (int i = 0; i < kCableCount; ++i) sample.encoder_m[i] = sway_.rest[6 + i];
+    sample.force_n = sway_.rest[6 + kCableCount];
+    return sample;
+  }
+  const std::size_t begin = window_begin();
   Eigen::Vector3d position_sum = Eigen::Vector3d::Zero();
   double tension_sum = 0.0;
-  for (std::size_t k = 0; k < count_; ++k) {
+  for (std::size_t k = begin; k < count_; ++k) {
     const EquilibriumObservation& o = at(k);
     position_sum += o.position_world;
     tension_sum += o.tension_n;
     for (int i = 0; i < kCableCount; ++i) sample.encoder_m[i] += o.encoder_m[i];
   }
-  const double n = static_cast<double>(count_);
+  const double n = static_cast<double>(count_ - begin);
   sample.position_world = position_sum / n;
-  sample.world_R_platform = mean_orientation();
+  sample.world_R_platform = mean_orientation(begin);
   for (double& encoder_m : sample.encoder_m) encoder_m /= n;
   sample.force_n = tension_sum / n;
   return sample;
@@ -174,29 +401,22 @@ Sample EquilibriumDetector::average() const {
 
 SampleSigmas EquilibriumDetector::average_sigmas(const NoiseSigmas& per_reading) const {
   assert(count_ > 0);
-  const std::span<const double> series(scratch_.data(), count_);
-  const auto sigma_of_mean = [&](auto&& reading, double floor) {
-    for (std::size_t k = 0; k < count_; ++k) scratch_[k] = reading(at(k));
+  const std::size_t begin = window_begin();
+  const std::span<const double> series(scratch_.data(), count_ - begin);
+  const Eigen::Quaterniond mean_q = mean_orientation(begin);
+  // The standard error of coordinate c's value in average().
+  const auto sigma_of = [&](int c, double floor) {
+    if (last_check_sway_) return std::max(sway_.scatter[c], floor) * sway_.factor[c];
+    for (std::size_t k = begin; k < count_; ++k) scratch_[k - begin] = coordinate(at(k), c, mean_q);
     return window_statistics(series, floor).sigma_of_mean;
   };
   SampleSigmas sigma;
-  for (int i = 0; i < kCableCount; ++i) {
-    sigma.encoder_m[i] =
-        sigma_of_mean([i](const EquilibriumObservation& o) { return o.encoder_m[i]; }, per_reading.encoder_m);
-  }
-  sigma.force_n = sigma_of_mean([](const EquilibriumObservation& o) { return o.tension_n; }, per_reading.force_n);
-  const Eigen::Quaterniond mean_q = mean_orientation();
+  for (int i = 0; i < kCableCount; ++i) sigma.encoder_m[i] = sigma_of(6 + i, per_reading.encoder_m);
+  sigma.force_n = sigma_of(6 + kCableCount, per_reading.force_n);
   double position_square = 0.0, rotation_square = 0.0;
   for (int axis = 0; axis < 3; ++axis) {
-    position_square += std::pow(
-        sigma_of_mean([axis](const EquilibriumObservation& o) { return o.position_world(axis); }, per_reading.position_m),
-        2);
-    rotation_square += std::pow(sigma_of_mean(
-                                    [&, axis](const EquilibriumObservation& o) {
-                                      return so3_log(mean_q.conjugate() * o.world_R_platform)(axis);
-                                    },
-                                    per_reading.orientation_rad),
-                                2);
+    position_square += std::pow(sigma_of(axis, per_reading.position_m), 2);
+    rotation_square += std::pow(sigma_of(3 + axis, per_reading.orientation_rad), 2);
   }
   sigma.position_m = std::sqrt(position_square / 3.0);
   sigma.orientation_rad = std::sqrt(rotation_square / 3.0);

@@ -28,14 +28,49 @@
 //    motion.
 // One observation under a threshold is never enough (docs/STYLE.md).
 //
+// A platform on long cables sways after a move with a period of seconds and
+// little damping; waiting until the sway is below the rate thresholds can
+// take minutes. With estimate_sway, a window whose speed or angular rate is
+// above its limit is tried as a sway about a rest state instead: over the
+// last sway_window_us (at least min_samples observations), every coordinate
+// (position, rotation relative to the mean orientation, encoders, tension)
+// is fitted with
+//   y(t) = rest + exp(-lambda t) (a cos(w t) + b sin(w t)),
+// one decaying oscillation (w, lambda) shared by all coordinates, found by
+// a grid search and refinement on bin means of the position. The window is
+// a sway about rest (kSwayEstimated, settled()) when:
+//  - w lies inside the searched range: at least kMinSwayPeriods periods in
+//    the window, at least kMinSamplesPerPeriod observations per period;
+//  - the oscillation is there: its F statistic against a constant is at
+//    least kMinSwaySignificance on a position or rotation axis (a platform
+//    at rest whose noise once reads as motion is no sway);
+//  - every position, rotation and tension coordinate's residual variance is
+//    at most max_sway_misfit times its noise variance, the noise from the
+//    residuals' differences 1/20 period apart (which a smooth misfit, a
+//    second mode or a drift of the rest hardly enters, while the residuals'
+//    variance grows with them; readings held between sensor updates still
+//    differ over that lag).
+// The load cell's stable bit is not asked then: the cell clears it for the
+// very sway being fitted, and the tension must fit the same oscillation.
+// average() and average_sigmas() give the fitted rest state and its
+// standard errors: the residuals' scatter (per-reading floor) times the
+// rest parameter's least-squares factor, times the residuals' correlation
+// (window_statistics.h). The fit is repeated at most every
+// kSwayRefitObservations new observations.
+// A sway of several modes with different periods does not fit one
+// oscillation and is waited out as before. The rest's sigma does not count
+// the uncertainty of w and lambda (over whole periods the rest is nearly
+// uncorrelated with them).
+//
 // average_sigmas() gives the row's own noise (solver/model/sample.h
 // SampleSigmas): each reading's standard error of the window mean
 // (window_statistics.h) with robot.toml's per-reading sigma as the floor.
 //
 // Memory: a fixed-capacity ring and scratch allocated at construction; add(),
-// check(), average() and average_sigmas() never allocate. When more than `capacity` observations fall in
-// the window the oldest are dropped and the window can never be covered:
-// size capacity >= window_us x sample rate (+ margin).
+// check(), average() and average_sigmas() never allocate. When more than
+// `capacity` observations fall in the window the oldest are dropped and the
+// window can never be covered: size capacity >= the longer of window_us and
+// sway_window_us x sample rate (+ margin).
 // Time is passed in with each observation ([us], the source's stamp); time
 // going backwards resets the window.
 // Not thread-safe.
@@ -63,6 +98,9 @@ struct EquilibriumThresholds {
   double max_speed_mps = 0.002;           // platform speed [m/s]
   double max_angular_rate_radps = 0.002;  // platform angular rate [rad/s]
   double max_tension_std_n = 10.0;        // tension standard deviation [N]
+  bool estimate_sway = true;               // false: wait for rest (see above)
+  hal::TimeUs sway_window_us = 40'000'000; // window of the sway fit [us, source time]
+  double max_sway_misfit = 1.5;           // residual / noise variance of a sway fit
 };
 
 struct EquilibriumObservation {
@@ -81,6 +119,7 @@ enum class EquilibriumVerdict {
   kMoving,          // speed too large
   kRotating,        // angular rate too large
   kSettled,
+  kSwayEstimated,   // not at rest, but a sway about a rest state that the fit estimates
 };
 
 const char* to_string(EquilibriumVerdict verdict);
@@ -93,7 +132,11 @@ struct EquilibriumCheck {
   double speed_mps = 0.0;            // measured as described above, noise allowance taken off
   double angular_rate_radps = 0.0;
   double tension_std_n = 0.0;
-  bool settled() const { return verdict == EquilibriumVerdict::kSettled; }
+  double sway_period_s = 0.0;        // of the last sway fit, 0 without one
+  double sway_misfit = 0.0;          // its largest residual / noise variance
+  bool settled() const {
+    return verdict == EquilibriumVerdict::kSettled || verdict == EquilibriumVerdict::kSwayEstimated;
+  }
 };
 
 class EquilibriumDetector {
@@ -103,6 +146,14 @@ class EquilibriumDetector {
   // pure noise exceeds 2 standard errors of a 3-D change (chi-square with 3
   // degrees of freedom above 12) with probability 0.007.
   static constexpr double kNoiseAllowance = 2.0;
+  static constexpr double kMinSwayPeriods = 1.5;
+  static constexpr int kMinSamplesPerPeriod = 10;
+  static constexpr int kSwayRefitObservations = 25;
+  // Least F statistic of the oscillation against a constant (largest over
+  // the position and rotation axes): noise alone, even at the best of the
+  // searched periods, stays far below.
+  static constexpr double kMinSwaySignificance = 100.0;
+  static constexpr int kSwayBins = 200;  // bin means of the grid search
 
   // capacity >= 2: the most observations kept (see above).
   EquilibriumDetector(const EquilibriumThresholds& thresholds, std::size_t capacity);
@@ -112,7 +163,8 @@ class EquilibriumDetector {
   void add(const EquilibriumObservation& observation);
   EquilibriumCheck check() const;
   // Mean of the window: position, sign-aligned normalized quaternion mean,
-  // encoders and tension. Precondition: at least one observation.
+  // encoders and tension; the fitted rest state when the last check() was
+  // kSwayEstimated. Precondition: at least one observation.
   Sample average() const;
   // The standard errors of average()'s readings, with `per_reading` as the
   // floor of each reading's scatter. The pose's are the RMS over the three
@@ -120,18 +172,47 @@ class EquilibriumDetector {
   // Precondition: at least one observation.
   SampleSigmas average_sigmas(const NoiseSigmas& per_reading) const;
 
-  int size() const { return static_cast<int>(count_); }
+  // Observations in the rest window (the ring may hold the sway window too).
+  int size() const { return static_cast<int>(count_ - window_begin()); }
   const EquilibriumThresholds& thresholds() const { return thresholds_; }
 
  private:
+  // The fit of one coordinate set: rest values and their standard-error
+  // factors (see above), valid for the newest observation it was made at.
+  static constexpr int kSwayCoordinates = 7 + kCableCount;  // position 3, rotation 3, encoders, tension
+  struct SwayFit {
+    bool accepted = false;
+    hal::TimeUs newest_us = -1;
+    std::size_t added_at = 0;
+    double omega_radps = 0.0, decay_per_s = 0.0;
+    double misfit = 0.0;
+    Eigen::Quaterniond mean_q = Eigen::Quaterniond::Identity();
+    std::array<double, kSwayCoordinates> rest{}, scatter{}, factor{};
+  };
+
   const EquilibriumObservation& at(std::size_t k) const;  // k = 0: oldest
-  Eigen::Quaterniond mean_orientation() const;
+  // The oldest observation of the rest window (the last window_us, at least
+  // min_samples); the ring holds the longer sway window before it.
+  std::size_t window_begin() const;
+  Eigen::Quaterniond mean_orientation(std::size_t begin) const;
+  double coordinate(const EquilibriumObservation& o, int c, const Eigen::Quaterniond& mean_q) const;
+  // Fits the sway window (see above) into sway_, unless fitted recently.
+  void fit_sway() const;
+  double sway_residual_sum(double omega, double decay) const;
 
   EquilibriumThresholds thresholds_;
   std::vector<EquilibriumObservation> ring_;
   mutable std::vector<double> scratch_;  // one reading's series, for average_sigmas()
   std::size_t first_ = 0;
   std::size_t count_ = 0;
+  std::size_t added_ = 0;       // observations added since reset()
+  mutable SwayFit sway_;
+  mutable bool last_check_sway_ = false;  // average() is then the fit's
+  // Bin means of the sway window's position (time [s], x, y, z, count).
+  mutable std::vector<std::array<double, 5>> bins_;
+  // One coordinate's values and the fit's basis functions over the sway window.
+  mutable std::vector<double> values_;
+  mutable std::vector<Eigen::Vector3d> basis_;
 };
 
 }  // namespace cdpr::calibration

@@ -159,8 +159,15 @@ Table<CalibratorOptions> equilibrium_table() {
            kPositive, "rad/s", "");
   t.number("max_tension_std", [](auto& o) -> auto& { return o.equilibrium.max_tension_std_n; }, 10.0, kPositive,
            "N", "load-cell standard deviation over the window");
-  t.integer("capacity", &CalibratorOptions::equilibrium_capacity, 1024, {2, 10'000'000}, "",
-            "ring size, >= window x pose rate with margin");
+  t.boolean("estimate_sway", [](auto& o) -> auto& { return o.equilibrium.estimate_sway; }, true,
+            "a platform still swaying is fitted as a decaying oscillation about its rest, and the fitted rest is "
+            "the sample; false: wait until it is at rest");
+  t.duration("sway_window_s", [](auto& o) -> auto& { return o.equilibrium.sway_window_us; }, 40.0, kS,
+             "the sway fit's window in the pose source's own time, >= 1.5 sway periods");
+  t.number("max_sway_misfit", [](auto& o) -> auto& { return o.equilibrium.max_sway_misfit; }, 1.5, kPositive, "",
+           "largest residual / noise variance of a sway fit: more is not one sway about a rest, and is waited out");
+  t.integer("capacity", &CalibratorOptions::equilibrium_capacity, 4096, {2, 10'000'000}, "",
+            "ring size, >= the longer of window_s and sway_window_s x pose rate with margin");
   return t;
 }
 

@@ -2,6 +2,7 @@
 // platform settles into the true equilibrium of the new cable lengths.
 
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -20,11 +21,12 @@ TEST(RobotPhysics, PlatformSettlesIntoTheEquilibriumOfTheCommandedPayouts) {
   auto physics = RobotPhysics::at_rest(robot, start, PhysicsOptions{});
   ASSERT_TRUE(physics) << physics.error();
   EXPECT_LT((physics->pose().position_world - start).norm(), 1e-6);
-  // WHEN cable 0 is paid out by 2 m and cable 2 hauled in by 2 m, and 20 s pass
+  // WHEN cable 0 is paid out by 2 m and cable 2 hauled in by 2 m, and the sway has died out
   const double p0 = physics->payout_m(0), p2 = physics->payout_m(2);
   physics->set_target(0, p0 + 2.0);
   physics->set_target(2, p2 - 2.0);
   for (int k = 0; k < 2000; ++k) physics->advance(0.01);
+  for (int k = 0; k < 1000; ++k) physics->advance(1.0);
   // THEN the winches are there, and the platform rests where the true equilibrium of those payouts is
   EXPECT_TRUE(physics->at_target(0) && physics->at_target(2));
   EXPECT_EQ(physics->failed_solves(), 0);
@@ -37,6 +39,41 @@ TEST(RobotPhysics, PlatformSettlesIntoTheEquilibriumOfTheCommandedPayouts) {
   EXPECT_GT((physics->pose().position_world - start).norm(), 0.5);  // it did move
   EXPECT_LT((physics->pose().position_world - expected->world_T_platform.position_world).norm(), 1e-6);
   EXPECT_NEAR(physics->tension_n(0), expected->cables[0].tension_n, 1e-3);
+}
+
+TEST(RobotPhysics, PlatformSwaysAfterAMoveWithTheGeometricPeriodAndLightDamping) {
+  // GIVEN the large robot at rest in the middle of its workspace
+  const sim::TrueRobot robot = sim::preset_spec(sim::Preset::kLarge).robot;
+  PhysicsOptions options;
+  auto physics = RobotPhysics::at_rest(robot, Eigen::Vector3d(120.0, 110.0, 17.0), options);
+  ASSERT_TRUE(physics);
+  // WHEN two cables move by 2 m at the profile speed, and the platform's x is followed afterwards
+  physics->set_target(0, physics->payout_m(0) + 2.0);
+  physics->set_target(2, physics->payout_m(2) - 2.0);
+  while (!(physics->at_target(0) && physics->at_target(2))) physics->advance(0.01);
+  physics->advance(0.1);  // the last solve
+  const double rest_x = physics->rest().world_T_platform.position_world.x();
+  std::vector<double> crossings, peaks;
+  double previous = physics->pose().position_world.x() - rest_x, peak = 0.0;
+  for (int k = 0; k < 20000; ++k) {
+    physics->advance(0.01);
+    const double e = physics->pose().position_world.x() - rest_x;
+    peak = std::max(peak, std::abs(e));
+    if ((e > 0.0) != (previous > 0.0)) {
+      crossings.push_back(0.01 * k);
+      peaks.push_back(peak);
+      peak = 0.0;
+    }
+    previous = e;
+  }
+  // THEN it swings about the rest pose with a period of several seconds, losing a few % per period
+  ASSERT_GE(crossings.size(), 10u);
+  const double period_s = 2.0 * (crossings.back() - crossings[1]) / static_cast<double>(crossings.size() - 2);
+  EXPECT_NEAR(period_s, physics->sway_period_s(), 0.02 * period_s);
+  EXPECT_GT(period_s, 3.0);
+  EXPECT_LT(period_s, 30.0);
+  const double decay_per_period = std::pow(peaks.back() / peaks[2], 2.0 / static_cast<double>(peaks.size() - 3));
+  EXPECT_NEAR(decay_per_period, std::exp(-2.0 * M_PI * options.damping_ratio), 0.03);
 }
 
 }  // namespace
@@ -55,6 +92,7 @@ TEST(RobotPhysics, FindsTheNewRestPoseAfterAMoveThroughSlackCables) {
   // WHEN every winch runs there at the same speed (so cables go slack on the way) and time passes
   for (int i = 0; i < kCableCount; ++i) physics->set_target(i, goal->cables[i].payout_m);
   for (int k = 0; k < 10000; ++k) physics->advance(0.01);
+  for (int k = 0; k < 1000; ++k) physics->advance(1.0);  // the sway dies out
   // THEN the platform rests at that pose
   EXPECT_LT((physics->pose().position_world - goal->world_T_platform.position_world).norm(), 1e-4);
 }

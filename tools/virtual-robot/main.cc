@@ -20,7 +20,7 @@ void on_signal(int) { g_stop.store(true); }
 
 int main(int argc, char** argv) {
   using cdpr::virtual_robot::VirtualRobotOptions;
-  CLI::App app{"virtual-robot: a simulated cable robot (true heavy-cable equilibrium, first-order settling, "
+  CLI::App app{"virtual-robot: a simulated cable robot (true heavy-cable equilibrium, lightly damped sway, "
                "sensor noise of the preset, optional hidden effects) serving CANopen over a Unix socket, a Modbus TCP or RTU load cell and a "
                "pose stream; writes robot.toml (nominal), truth.toml and 'ready' into --endpoints"};
   app.set_version_flag("--version", cdpr::version::version_text("virtual-robot"));
@@ -56,8 +56,12 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--noise-scale", options.noise_scale, "multiplies every sensor sigma of the preset; 0: noiseless")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
-  app.add_option("--time-constant", options.physics.time_constant_s, "platform settling time constant [s, simulated]")
-      ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--damping-ratio", options.physics.damping_ratio,
+                 "damping ratio of the platform's sway after a move (0: none, 0.05: light)")
+      ->check(CLI::Range(0.0, 0.99))->capture_default_str();
+  app.add_option("--sway-period", options.physics.sway_period_s,
+                 "sway period [s, simulated]; 0: from the cable geometry (several seconds on the large robot)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--winch-speed", options.physics.winch_speed_mps, "drive profile velocity [m/s, simulated]")
       ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--pose-rate", options.pose_rate_hz, "pose stream rate [Hz, real time]")

@@ -3,9 +3,22 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 namespace cdpr::virtual_robot {
 namespace {
+
+// One step of dt of  e'' + 2 zeta w e' + w^2 e = 0  (0 <= zeta < 1), exact:
+// the deviation e and its rate v of any number of coordinates at once.
+template <typename Deviation>
+void sway_step(double omega, double zeta, double dt, Deviation& e, Deviation& v) {
+  const double decay = zeta * omega;
+  const double omega_d = omega * std::sqrt(1.0 - zeta * zeta);
+  const double c = std::cos(omega_d * dt), s = std::sin(omega_d * dt), damp = std::exp(-decay * dt);
+  const Deviation e0 = e;
+  e = damp * (c * e0 + (s / omega_d) * (v + decay * e0));
+  v = damp * (c * v - (s / omega_d) * (omega * omega * e0 + decay * v));
+}
 
 // Where the platform would hang on straight chords of (1 - shrink) times
 // the given lengths, orientation kept: the lowest pose at which three chords
@@ -63,6 +76,7 @@ Expected<RobotPhysics, std::string> RobotPhysics::at_rest(const sim::TrueRobot& 
 
 RobotPhysics::RobotPhysics(const sim::TrueRobot& robot, const sim::Equilibrium& rest, const PhysicsOptions& options)
     : robot_(robot), options_(options), rest_(rest), pose_(rest.world_T_platform) {
+  omega_radps_ = natural_frequency_radps();
   for (int i = 0; i < kCableCount; ++i) {
     payout_m_[i] = rest.cables[i].payout_m + robot.encoder_offset_m[i];
     target_m_[i] = payout_m_[i];
@@ -86,12 +100,39 @@ void RobotPhysics::advance(double dt_s) {
   since_solve_s_ += dt_s;
   if (payout_m_ != solved_payout_m_ && since_solve_s_ >= options_.equilibrium_interval_s) solve_rest();
 
-  // First-order approach to the rest state: exact for any step length.
-  const double a = 1.0 - std::exp(-dt_s / options_.time_constant_s);
-  pose_.position_world += a * (rest_.world_T_platform.position_world - pose_.position_world);
-  pose_.world_R_platform = pose_.world_R_platform.slerp(a, rest_.world_T_platform.world_R_platform).normalized();
+  // The sway about the rest state, the rest state held for this step.
+  const double zeta = std::clamp(options_.damping_ratio, 0.0, 0.99);
+  Eigen::Vector3d e = pose_.position_world - rest_.world_T_platform.position_world;
+  sway_step(omega_radps_, zeta, dt_s, e, velocity_mps_);
+  pose_.position_world = rest_.world_T_platform.position_world + e;
+  const Eigen::Quaterniond& rest_r = rest_.world_T_platform.world_R_platform;
+  Eigen::Vector3d r = so3_log(rest_r.conjugate() * pose_.world_R_platform);
+  sway_step(omega_radps_, zeta, dt_s, r, angular_velocity_radps_);
+  pose_.world_R_platform = (rest_r * so3_exp(r)).normalized();
+  // Tensions approach their rest values with a first-order lag: an
+  // oscillator of its own would swing a cable's tension below zero.
+  const double a = 1.0 - std::exp(-dt_s / options_.tension_time_constant_s);
   for (int i = 0; i < kCableCount; ++i) tension_n_[i] += a * (rest_.cables[i].tension_n - tension_n_[i]);
 }
+
+double RobotPhysics::natural_frequency_radps() const {
+  if (options_.sway_period_s > 0.0) return 2.0 * std::numbers::pi / options_.sway_period_s;
+  Eigen::Matrix3d stiffness = Eigen::Matrix3d::Zero();
+  double mass_kg = robot_.robot.platform_mass_kg;
+  for (int i = 0; i < kCableCount; ++i) {
+    const sim::CableEquilibrium& cable = rest_.cables[i];
+    const Eigen::Vector3d chord = robot_.robot.winches[i].anchor_world - cable.attachment_world;
+    const double length = chord.norm();
+    if (!(length > 0.0)) continue;
+    const Eigen::Vector3d u = chord / length;
+    stiffness += cable.tension_n / length * (Eigen::Matrix3d::Identity() - u * u.transpose());
+    mass_kg += robot_.robot.cable_linear_density_kgpm * cable.free_arc_m / 3.0;
+  }
+  const double horizontal = 0.5 * (stiffness(0, 0) + stiffness(1, 1));
+  return horizontal > 0.0 && mass_kg > 0.0 ? std::sqrt(horizontal / mass_kg) : 1.0;
+}
+
+double RobotPhysics::sway_period_s() const { return 2.0 * std::numbers::pi / omega_radps_; }
 
 void RobotPhysics::solve_rest() {
   since_solve_s_ = 0.0;
@@ -117,6 +158,7 @@ void RobotPhysics::solve_rest() {
   }
   rest_ = *next;
   solved_payout_m_ = payout_m_;
+  omega_radps_ = natural_frequency_radps();
 }
 
 }  // namespace cdpr::virtual_robot
