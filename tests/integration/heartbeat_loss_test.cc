@@ -50,6 +50,12 @@ TEST(HeartbeatLoss, DrivesStopWithinHeartbeatTimePlusBrakingAfterKill9) {
   virtual_robot::VirtualRobotOptions options = large_robot_acceptance_options();
   options.time_scale = 1.0;
   options.noise_scale = 0.0;  // the stop distance, not the noise, is measured
+  // The winches' stop is measured through the platform, so the platform
+  // follows its rest pose without sway: critically damped, lagging a moving
+  // rest by 2 / w = kSettleLagS (a swaying platform would hide where the
+  // cables stopped).
+  options.physics.damping_ratio = 1.0;
+  options.physics.sway_period_s = M_PI * kSettleLagS;
   char pattern[] = "/tmp/cdpr-heartbeat-XXXXXX";
   const std::string dir = mkdtemp(pattern);
   options.dir = dir + "/robot";
