@@ -16,7 +16,15 @@ if(CDPR_SANITIZE)
   endforeach()
 endif()
 
+# The order ctest -j starts them in (highest cost first) until it has timed
+# them itself: the slow ones first, so that none of the long runs starts
+# last and leaves the other core idle while it finishes.
+set(CDPR_TEST_COST_unit 1)
+set(CDPR_TEST_COST_integration 10)
+set(CDPR_TEST_COST_slow 100)
+
 # cdpr_test_kind(<kind> <test>...): labels tests added with add_test().
 function(cdpr_test_kind kind)
-  set_tests_properties(${ARGN} PROPERTIES LABELS ${kind} TIMEOUT ${CDPR_TEST_TIMEOUT_${kind}})
+  set_tests_properties(${ARGN} PROPERTIES LABELS ${kind} TIMEOUT ${CDPR_TEST_TIMEOUT_${kind}}
+                       COST ${CDPR_TEST_COST_${kind}})
 endfunction()
