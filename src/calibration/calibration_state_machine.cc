@@ -380,10 +380,7 @@ void CalibrationStateMachine::run_validate_and_commit(hal::TimeUs now_us) {
     const Calibration* previous = previous_ ? &previous_->calibration : nullptr;
     const ValidationResult validation = validate_fit(*solve_result_, robot_, previous, options_.validation);
     if (!validation.accepted()) return fail("fit refused: " + validation.summary(), now_us, false);
-    if (utc_now_text_) calibration.created = utc_now_text_();
-    if (calibration.created.empty()) calibration.created = "1970-01-01T00:00:00Z";
-    calibration.robot = robot_.name;
-    calibration.samples = static_cast<int>(samples_.size());
+    stamp_for_commit(calibration, robot_, samples_.size(), utc_now_text_);
     for (const WinchCalibration& w : calibration.winches) {
       status_.largest_anchor_sigma_m = std::max(status_.largest_anchor_sigma_m, w.anchor_sigma.maxCoeff());
       status_.largest_offset_sigma_m = std::max(status_.largest_offset_sigma_m, w.offset_sigma_m);

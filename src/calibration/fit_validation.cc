@@ -90,4 +90,12 @@ ValidationResult validate_fit(const CalibrationResult& result, const Robot& robo
   return validation;
 }
 
+void stamp_for_commit(Calibration& calibration, const Robot& robot, std::size_t samples,
+                      const std::function<std::string()>& utc_now_text) {
+  if (utc_now_text) calibration.created = utc_now_text();
+  if (calibration.created.empty()) calibration.created = "1970-01-01T00:00:00Z";
+  calibration.robot = robot.name;
+  calibration.samples = static_cast<int>(samples);
+}
+
 }  // namespace cdpr::calibration

@@ -18,6 +18,8 @@
 //    legitimately changes them.
 // Pure logic.
 
+#include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -47,5 +49,11 @@ struct ValidationResult {
 // `previous` may be null (first calibration).
 ValidationResult validate_fit(const CalibrationResult& result, const Robot& robot, const Calibration* previous,
                               const ValidationLimits& limits);
+
+// Fills in what a validated fit needs before the store commits it: `created`
+// from utc_now_text (the epoch when it gives nothing), the robot's name and
+// the number of samples fitted.
+void stamp_for_commit(Calibration& calibration, const Robot& robot, std::size_t samples,
+                      const std::function<std::string()>& utc_now_text);
 
 }  // namespace cdpr::calibration

@@ -140,10 +140,7 @@ bool RunRefitter::poll(bool calibration_running) {
     return true;
   }
   Calibration& calibration = result.calibration;
-  if (utc_now_text_) calibration.created = utc_now_text_();
-  if (calibration.created.empty()) calibration.created = "1970-01-01T00:00:00Z";
-  calibration.robot = job_.robot.name;
-  calibration.samples = static_cast<int>(job_.samples.size());
+  calibration::stamp_for_commit(calibration, job_.robot, job_.samples.size(), utc_now_text_);
   const auto committed = store_.commit(calibration);
   if (!committed) {
     finish("failed", "not committed: store: " + committed.error().message());
