@@ -187,7 +187,9 @@ std::vector<SensorReading> attribute_row(const Problem& problem, int row_id, int
     }
     if (best < 0) break;
     left_out.push_back(best);
-    bool another = false;
+    // The row's pose can absorb a second gross error into its prior, leaving
+    // every remaining reading small but the rest's chi-square far above it.
+    bool another = best_chi2 > threshold_sigma * threshold_sigma;
     for (std::size_t r = 0; r < readings.size(); ++r) {
       const bool out = std::find(left_out.begin(), left_out.end(), static_cast<int>(r)) != left_out.end();
       another = another || (!out && std::abs(residuals[r]) > threshold_sigma);

@@ -8,7 +8,8 @@
 // turn; the reading whose removal leaves the smallest chi-square of the
 // rest is the gross error, its residual that refit's prediction minus the
 // reading. While another reading still stands out in that refit, the one
-// whose removal (with the first) explains the rest best is left out too.
+// whose removal (with the first) explains the rest best is left out too,
+// and so while the rest's chi-square stays above the threshold squared.
 
 #include <vector>
 

@@ -212,6 +212,20 @@ TEST(RobustCalibration, AGrossErrorAbsorbedByItsCableIsStillNamed) {
   expect_planted_named_without_misfit(config, 1.0);
 }
 
+TEST(RobustCalibration, ARowWithAnEncoderErrorAndALoadCellSpikeLosesBoth) {
+  // GIVEN 45 poses of the small robot over its footprint, nominal anchors
+  // 0.5 m off, where row 35 holds a 0.83 m encoder error on cable 2 and a
+  // -198 N load-cell spike: without the load cell, the row's pose takes the
+  // encoder error into its prior and every reading of the row looks clean
+  sim::DatasetConfig config = small(45, 23);
+  config.anchor_perturbation_m = 0.5;
+  config.workspace_min = Eigen::Vector3d(1.5, 0.7, 3.0);
+  config.workspace_max = Eigen::Vector3d(11.0, 3.8, 22.0);
+  // WHEN calibrated with default options
+  // THEN the row's chi-square still stands out, so both readings are left out
+  expect_planted_named_without_misfit(config, 0.2);
+}
+
 TEST(RobustCalibration, AFitThatKeptAGrossErrorAndMisfitsIsRedoneFromTheBadRowLeftOut) {
   // GIVEN 8 poses of the small robot, nominal anchors 1 m off, a 1.75 m
   // encoder error and a load-cell spike, where the robust fit flags good
