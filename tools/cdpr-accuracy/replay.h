@@ -8,8 +8,9 @@
 // Robot-time model, per waypoint: the move, max_i |payout_i(to) -
 // payout_i(from)| / winch speed (the winches run coordinated, the farthest
 // at the profile speed; acceleration ignored), from the previous waypoint
-// (the first from the start pose), plus `settle_s`: the wait for rest and
-// the rest window, taken as the same for every waypoint. The solve time is
+// (the first from the start pose), plus `settle_s`: the wait for the
+// sample, taken as the same for every waypoint (by default the daemon's
+// sway window, expected_settle_s()). The solve time is
 // not robot time. A waypoint where the true robot has no taut rest is
 // skipped after its move and settle time.
 //
