@@ -49,7 +49,9 @@ struct CalibrationOptions {
   // and stopping them at 200 left them up to 0.3 m short even on noiseless data.
   int max_iterations = 1000;
   // Sigma [m] of the attachment-height consistency of Eq. (15): a model
-  // identity, not a sensor, so it is held much tighter than the pose noise.
+  // identity, not a sensor, so it is held tight against the pose noise. For
+  // rows weighted by robot.toml's noise; a row with its own sigmas scales it
+  // down with its pose noise (solver/model/sample.h, row_height_sigma()).
   double height_sigma_m = 1e-2;
   // Model terms fitted on top of the catenary (solver/model/effects.h), each with
   // its own EffectKey variable started at 0 ("absent"); catenary only.

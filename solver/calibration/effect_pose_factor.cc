@@ -41,7 +41,7 @@ EffectPoseFactor::EffectPoseFactor(const Robot& robot, int pose_index, const Sam
       force_n_(sample.force_n),
       sigma_(reading_sigmas(robot, sample)),
       left_out_(left_out_rows(sample)),
-      sigma_height_m_(sigma_height_m),
+      sigma_height_m_(row_height_sigma(robot, sample, sigma_height_m)),
       loss_(loss) {
   keys_ = {PoseKey(pose_index), ReferenceForceKey(pose_index)};
   block_dims_ = {6, 2};

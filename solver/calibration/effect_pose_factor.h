@@ -41,7 +41,8 @@ class EffectPoseFactor final : public Factor {
   static constexpr int kResidualDim = 2 * kCableCount + 1;
   static constexpr int kBaseKeyCount = 2 + 2 * kCableCount;
 
-  // `robot` must outlive the factor; `effects` without repeats.
+  // `robot` must outlive the factor; `effects` without repeats; sigma_height_m
+  // as StaticPoseFactor's.
   EffectPoseFactor(const Robot& robot, int pose_index, const Sample& sample, double sigma_height_m, Loss loss,
                    const std::vector<Effect>& effects);
 

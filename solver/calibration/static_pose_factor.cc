@@ -83,7 +83,7 @@ StaticPoseFactor::StaticPoseFactor(const Robot& robot, int pose_index, const Sam
       force_n_(sample.force_n),
       sigma_(reading_sigmas(robot, sample)),
       left_out_(left_out_rows(sample)),
-      sigma_height_m_(sigma_height_m),
+      sigma_height_m_(row_height_sigma(robot, sample, sigma_height_m)),
       loss_(loss) {
   keys_[0] = PoseKey(pose_index);
   keys_[1] = ReferenceForceKey(pose_index);

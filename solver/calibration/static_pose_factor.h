@@ -25,7 +25,8 @@ class StaticPoseFactor final : public Factor {
   static constexpr int kResidualDim = 2 * kCableCount + 1;
   static constexpr int kKeyCount = 2 + 2 * kCableCount;
 
-  // `robot` must outlive the factor; sigma_height_m weights Eq. (15).
+  // `robot` must outlive the factor; sigma_height_m weights Eq. (15) (for a
+  // row with its own sigmas, scaled as row_height_sigma() says).
   StaticPoseFactor(const Robot& robot, int pose_index, const Sample& sample, double sigma_height_m, Loss loss);
 
   int residual_dim() const override { return kResidualDim; }

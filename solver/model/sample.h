@@ -1,6 +1,7 @@
 #pragma once
 // One static pose as measured (a row of samples.csv, docs/FORMATS.md).
 
+#include <algorithm>
 #include <array>
 
 #include <Eigen/Core>
@@ -48,6 +49,19 @@ inline SampleSigmas reading_sigmas(const Robot& robot, const Sample& sample) {
   s.position_m = robot.noise.position_m;
   s.orientation_rad = robot.noise.orientation_rad;
   return s;
+}
+
+// The sigma [m] that holds `sample`'s attachment-height consistency (Eq. 15)
+// for a fit whose setting is `height_sigma_m`. The setting is made for rows
+// weighted by robot.toml's per-reading noise; a row with its own, smaller
+// sigmas is held tighter in proportion to its pose noise, so the identity
+// keeps the same weight against the row's readings whichever noise they
+// carry (left loose, it lets the fit bend the cables' shapes within noise
+// the row does not have, and the sigmas come out larger than the errors).
+// Never looser than the setting.
+inline double row_height_sigma(const Robot& robot, const Sample& sample, double height_sigma_m) {
+  if (!sample.has_own_sigma() || !(robot.noise.position_m > 0.0)) return height_sigma_m;
+  return height_sigma_m * std::min(1.0, sample.sigma.position_m / robot.noise.position_m);
 }
 
 }  // namespace cdpr

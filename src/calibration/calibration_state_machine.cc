@@ -249,6 +249,7 @@ void CalibrationStateMachine::run_plan(hal::TimeUs now_us) {
   }
   SequentialOptions sequential = options_.sequential;
   sequential.min_count = options_.validation.min_samples;
+  sequential.settle_s = expected_settle_s(options_.equilibrium);
   if (const std::string problem = waypoints_.start(planning_robot, offsets_m, start_world, options_.planner,
                                                    options_.strategy, sequential, now_us);
       !problem.empty()) {

@@ -75,6 +75,10 @@
 
 namespace cdpr::calibration {
 
+// The equilibrium detector's ring size: the 40 s sway window at a 100 Hz
+// pose source, with margin (the daemon's [equilibrium] capacity default).
+inline constexpr std::size_t kEquilibriumCapacity = 4096;
+
 struct CalibratorOptions {
   PlannerOptions planner;
   WaypointStrategy strategy = WaypointStrategy::kSpread;
@@ -82,7 +86,7 @@ struct CalibratorOptions {
   // min_count is validation.min_samples, so that a run it stops can be accepted.
   SequentialOptions sequential;
   EquilibriumThresholds equilibrium;
-  std::size_t equilibrium_capacity = 1024;  // >= window x pose rate, with margin
+  std::size_t equilibrium_capacity = kEquilibriumCapacity;  // >= window x pose rate, with margin
   ValidationLimits validation;
   MonitorLimits monitor;
   // Preflight waits this long for the first word from every device (a node's

@@ -124,6 +124,15 @@ enum class EquilibriumVerdict {
 
 const char* to_string(EquilibriumVerdict verdict);
 
+// The robot time [s] a waypoint is expected to wait before its sample, for
+// planning: a move excites sway, so with the sway estimate on the sample
+// comes when the sway window is full; waiting for rest is modelled by the
+// rest window alone (optimistic for a platform that sways).
+inline double expected_settle_s(const EquilibriumThresholds& t) {
+  const hal::TimeUs wait_us = t.estimate_sway && t.sway_window_us > t.window_us ? t.sway_window_us : t.window_us;
+  return 1e-6 * static_cast<double>(wait_us);
+}
+
 // The verdict and the measured values behind it (for the status line).
 struct EquilibriumCheck {
   EquilibriumVerdict verdict = EquilibriumVerdict::kNotEnoughData;

@@ -32,6 +32,7 @@
 
 #include "solver/calibration/calibrate.h"
 #include "solver/calibration/pose_design.h"
+#include "src/calibration/equilibrium_detector.h"
 #include "src/calibration/waypoint_planner.h"
 #include "src/calibration/waypoint_tour.h"
 
@@ -46,7 +47,9 @@ struct SequentialOptions {
   int min_count = 0;                    // samples before stopping, at least
   int max_count = 35;                   // samples, at most
   double winch_speed_mps = 2.0;         // profile speed of the winches [m/s]
-  double settle_s = 10.0;               // expected wait for rest plus the window, per waypoint [s]
+  // Expected wait for the sample after a move, per waypoint [s]: the
+  // detector's (equilibrium_detector.h; its defaults: the 40 s sway window).
+  double settle_s = expected_settle_s(EquilibriumThresholds{});
   // The score divides a candidate's gain by its move and settle time plus
   // this [s]. The gain per second of the next move alone is myopic: it
   // prefers short hops that gain little, each of which still costs a settle

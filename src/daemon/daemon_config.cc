@@ -166,7 +166,8 @@ Table<CalibratorOptions> equilibrium_table() {
              "the sway fit's window in the pose source's own time, >= 1.5 sway periods");
   t.number("max_sway_misfit", [](auto& o) -> auto& { return o.equilibrium.max_sway_misfit; }, 1.5, kPositive, "",
            "largest residual / noise variance of a sway fit: more is not one sway about a rest, and is waited out");
-  t.integer("capacity", &CalibratorOptions::equilibrium_capacity, 4096, {2, 10'000'000}, "",
+  t.integer("capacity", &CalibratorOptions::equilibrium_capacity,
+            static_cast<std::int64_t>(calibration::kEquilibriumCapacity), {2, 10'000'000}, "",
             "ring size, >= the longer of window_s and sway_window_s x pose rate with margin");
   return t;
 }

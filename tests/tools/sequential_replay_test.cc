@@ -55,11 +55,12 @@ TEST(SequentialReplay, StopsAtMaxCountWhenTheTargetIsOutOfReach) {
 }
 
 TEST(SequentialReplay, ALooserTargetStopsSooner) {
-  // GIVEN the default target and one twice as loose
-  ReplayCase tight = large_case(Strategy::kSequential);
-  ReplayCase loose = tight;
-  loose.sequential.target_anchor_sigma_m *= 2.0;
-  loose.sequential.target_offset_sigma_m *= 2.0;
+  // GIVEN the default target and one twice as tight (the default one is
+  // often reached by the initial identifiable set alone)
+  ReplayCase loose = large_case(Strategy::kSequential);
+  ReplayCase tight = loose;
+  tight.sequential.target_anchor_sigma_m /= 2.0;
+  tight.sequential.target_offset_sigma_m /= 2.0;
   int tight_waypoints = 0, loose_waypoints = 0;
   for (const std::uint64_t seed : {6u, 7u, 8u, 9u}) {
     SCOPED_TRACE(seed);

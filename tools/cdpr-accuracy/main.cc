@@ -128,7 +128,7 @@ int main(int argc, char** argv) {
   app.add_option("--winch-speed", replay_case.sequential.winch_speed_mps, "robot-time model: winch profile speed [m/s]")
       ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--settle", replay_case.sequential.settle_s,
-                 "robot-time model: wait for rest plus the rest window, per waypoint [s]")
+                 "robot-time model: wait for the sample after each move [s] (the daemon's sway window)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--score-horizon", replay_case.sequential.score_horizon_s,
                  "sequential: time added to each candidate's move and settle in its score [s]")

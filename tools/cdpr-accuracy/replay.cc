@@ -43,7 +43,13 @@ class Rig {
     at_ = reached;
     if (!state) return std::nullopt;
     sim::Rng noise = sim::Rng::stream(seed_, sim::kStreamSensorNoise, static_cast<std::uint64_t>(index));
-    return sim::measure(data_.true_robot, *state, case_.noise_scale, noise, sample_id_++);
+    Sample sample = sim::measure(data_.true_robot, *state, case_.noise_scale, noise, sample_id_++);
+    const NoiseSigmas& reading = data_.nominal.noise;
+    sample.sigma.encoder_m.fill(case_.noise_scale * reading.encoder_m);
+    sample.sigma.force_n = case_.noise_scale * reading.force_n;
+    sample.sigma.position_m = case_.noise_scale * reading.position_m;
+    sample.sigma.orientation_rad = case_.noise_scale * reading.orientation_rad;
+    return sample;
   }
 
   double robot_time_s() const { return robot_time_s_; }
@@ -105,7 +111,7 @@ ReplayResult replay(const ReplayCase& c, std::uint64_t seed) {
   config.pose_count = 1;  // for the robots and the truth; the samples are measured here
   config.seed = seed;
   config.anchor_perturbation_m = c.anchor_perturbation_m;
-  config.noise_scale = c.noise_scale;
+  config.noise_scale = 1.0;  // robot.toml: one reading's noise; the rows carry their own (Rig::visit)
   const auto data = sim::simulate_dataset(config);
   if (!data) {
     r.message = "simulation failed: " + data.error();

@@ -8,16 +8,18 @@
 // Robot-time model, per waypoint: the move, max_i |payout_i(to) -
 // payout_i(from)| / winch speed (the winches run coordinated, the farthest
 // at the profile speed; acceleration ignored), from the previous waypoint
-// (the first from the start pose), plus `settle_s`: the wait for rest and
-// the rest window, taken as the same for every waypoint. The solve time is
+// (the first from the start pose), plus `settle_s`: the wait for the
+// sample, taken as the same for every waypoint (by default the daemon's
+// sway window, expected_settle_s()). The solve time is
 // not robot time. A waypoint where the true robot has no taut rest is
 // skipped after its move and settle time.
 //
 // A sample is one reading of every sensor at the true rest with the
 // preset's noise times `noise_scale`: the daemon averages a rest window into
 // a row whose noise is a fraction of one reading's (docs/calibration.md
-// "Honest sigmas"), and robot.toml's [noise] says so, as the daemon's rows'
-// own sigmas do. The default 0.11 is what those sigmas are on the virtual
+// "Honest sigmas"). Each row carries that noise as its own sigmas, and the
+// nominal robot keeps the preset's per-reading noise, as robot.toml and the
+// daemon's rows do. The default 0.11 is what those sigmas are on the virtual
 // robot: a 2 s window of about 100 independent readings.
 //
 // The true rest is solved at the planned position and heading; where the

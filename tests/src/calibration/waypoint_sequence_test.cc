@@ -1,0 +1,60 @@
+#include "src/calibration/waypoint_sequence.h"
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "../../solver/model/test_robots.h"
+
+namespace cdpr::calibration {
+namespace {
+
+PlannerOptions large_options() {
+  PlannerOptions options;
+  options.margin_m = 20.0;
+  options.z_min_m = 5.0;
+  options.z_max_m = 35.0;
+  options.grid_xy = 4;
+  options.grid_z = 2;
+  options.min_tension_n = 20.0;
+  options.max_tension_n = 3000.0;
+  return options;
+}
+
+TEST(WaypointSequence, AFailedReSolveFallsBackToTheNextSpreadWaypoint) {
+  // GIVEN the sequential strategy on the large robot
+  const Robot robot = test::large_robot();
+  SequentialOptions sequential;
+  sequential.max_count = 12;
+  WaypointSequence sequence;
+  ASSERT_EQ(sequence.start(robot, {}, Eigen::Vector3d(120, 110, 10), large_options(), WaypointStrategy::kSequential,
+                           sequential, 0),
+            "");
+  // WHEN every row is one no fit can start from (a negative tension), so
+  // every re-solve fails
+  std::vector<const Waypoint*> visited;
+  int fallbacks = 0;
+  hal::TimeUs now_us = 0;
+  while (const Waypoint* w = sequence.current()) {
+    ASSERT_LT(visited.size(), 40u);
+    EXPECT_EQ(std::count(visited.begin(), visited.end(), w), 0) << "visited twice";
+    visited.push_back(w);
+    Sample sample;
+    sample.id = static_cast<int>(visited.size());
+    sample.position_world = w->rest.world_T_platform.position_world;
+    sample.world_R_platform = w->rest.world_T_platform.world_R_platform;
+    sample.force_n = -100.0;
+    now_us += 60'000'000;
+    sequence.sampled(sample, now_us);
+    if (sequence.remark().find("failed: next waypoint in spread order") != std::string::npos) ++fallbacks;
+  }
+  // THEN the run goes on to max_count, each waypoint after the initial set
+  // the next unused one in spread order, and the remark says so
+  EXPECT_EQ(static_cast<int>(visited.size()), sequential.max_count);
+  EXPECT_GE(fallbacks, 1);
+}
+
+}  // namespace
+}  // namespace cdpr::calibration
