@@ -142,6 +142,39 @@ int degrees_of_freedom(const Problem& problem, const std::vector<Sample>& sample
   return rows - columns;
 }
 
+// Whether the linearisation the last solve ended with is, bit for bit, what
+// the factors give with `next` as the readings' loss instead of `current`:
+// both leave every reading row as least squares would (no other row sees
+// the readings' loss). The stored residuals are after `current`'s scaling;
+// a Huber residual just beyond the width is scaled to just above it, give
+// or take rounding, so those within a hair of the width do not count as
+// inside it.
+bool same_linearization(const BuiltProblem& built, const LevenbergMarquardt& lm, const LossFunction& current,
+                        const LossFunction& next, bool catenary) {
+  constexpr double kWidthMargin = 1.0 - 1e-9;
+  auto quadratic = [&](int factor, int row) {
+    const std::span<const double> r = lm.last_residuals(factor);
+    if (static_cast<std::size_t>(row) >= r.size()) return false;
+    const bool unscaled = current.kind == LossKind::kHuber && current.width > 0.0
+                              ? std::abs(r[row]) <= kWidthMargin * current.width
+                              : current.quadratic_at(r[row]);
+    return unscaled && next.quadratic_at(r[row]);
+  };
+  for (std::size_t k = 0; k < built.samples.size(); ++k) {
+    const int first = built.reading_factor[k];
+    if (catenary) {
+      for (int row : kReadingRows) {
+        if (!quadratic(first, row)) return false;
+      }
+    } else {
+      for (int i = 0; i < kCableCount; ++i) {
+        if (!quadratic(first + i, 0)) return false;
+      }
+    }
+  }
+  return true;
+}
+
 // The robust stages (CalibrationOptions::robust) on a built problem: Huber,
 // then Cauchy when a reading still stands out, then the gross-error test.
 // Returns the gross errors (empty on clean data); `summary` accumulates.
@@ -240,7 +273,14 @@ CalibrationResult calibrate_once(const Robot& robot, const std::vector<Sample>& 
       return result;
     }
   }
-  *built.reading_loss = LossFunction{LossKind::kHuber, options.huber_width};
+  const LossFunction final_loss{LossKind::kHuber, options.huber_width};
+  // On clean data the robust stage ends where its loss and the final one
+  // are both quadratic at every reading: its last linearisation is the
+  // final fit's first.
+  if (options.robust && same_linearization(built, lm, *built.reading_loss, final_loss, catenary)) {
+    lm.reuse_last_linearization();
+  }
+  *built.reading_loss = final_loss;
   lm.set_max_iterations(std::max(options.max_iterations - iterations, 0));
   result.solver = lm.solve();
   if (iterations > 0) result.solver.initial_cost = robust_summary.initial_cost;
@@ -253,6 +293,8 @@ CalibrationResult calibrate_once(const Robot& robot, const std::vector<Sample>& 
     globals.push_back(OffsetKey(i));
   }
   for (Effect e : options.effects) globals.push_back(EffectKey(e));
+  // The solve left the values and the loss as they are now.
+  lm.reuse_last_linearization();
   const Eigen::MatrixXd covariance = lm.covariance(globals);
   result.global_keys = globals;
   result.global_covariance = covariance;

@@ -400,8 +400,7 @@ void SchurComplement::solve(const double* b, double* x) {
                        g.first_if_contiguous(coupled_), x + g.column, reduced_rhs_.data());
     });
   }
-  solve_upper_transposed<0>(s_.data(), reduced_inverse_diagonal_.data(), n, reduced_rhs_.data());
-  solve_upper<0>(s_.data(), reduced_inverse_diagonal_.data(), n, reduced_rhs_.data());
+  solve_reduced();
   std::copy(reduced_rhs_.begin(), reduced_rhs_.end(), x_global);
   for (const Group& g : groups_) {
     for_group_dim(g.dim, [&](auto size) {
@@ -411,6 +410,21 @@ void SchurComplement::solve(const double* b, double* x) {
                         g.first_if_contiguous(coupled_), x_global, x + g.column);
     });
   }
+}
+
+void SchurComplement::solve_global(const double* b_global, double* x_global) {
+  const int n = global_dim_;
+  // solve()'s forward pass over the groups subtracts W' U'^-1 b_l = +0 from
+  // every entry: it leaves b_g as it is, so only the reduced solves remain.
+  std::copy(b_global, b_global + n, reduced_rhs_.begin());
+  solve_reduced();
+  std::copy(reduced_rhs_.begin(), reduced_rhs_.end(), x_global);
+}
+
+void SchurComplement::solve_reduced() {
+  const int n = global_dim_;
+  solve_upper_transposed<0>(s_.data(), reduced_inverse_diagonal_.data(), n, reduced_rhs_.data());
+  solve_upper<0>(s_.data(), reduced_inverse_diagonal_.data(), n, reduced_rhs_.data());
 }
 
 double SchurComplement::damping_quadratic(const double* x, double radius, double min_diagonal,

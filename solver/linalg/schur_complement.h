@@ -48,6 +48,7 @@ class SchurComplement {
   ~SchurComplement();
 
   int columns() const { return local_dim_ + global_dim_; }  // the groups' columns first, then global ones
+  int local_columns() const { return local_dim_; }
   int variable_column(int v) const { return jacobian_.variable_column(v); }
 
   // J^T J (kept inside) and J^T r (into `gradient`, columns() values) of `slot`.
@@ -57,6 +58,10 @@ class SchurComplement {
   FactorizationStatus factorize(double radius, double min_diagonal, double max_diagonal, std::string* message);
   // x = (J^T J + D / radius)^-1 b with the last successful factorisation; x may alias b.
   void solve(const double* b, double* x);
+  // The global part of solve() for a b whose local part is zero:
+  // x_g = S^-1 b_g (b_g and x_g: the global columns' values, may alias),
+  // the same values solve() gives there, without the groups' work.
+  void solve_global(const double* b_global, double* x_global);
   // x' D x / radius, the damping factorize(radius, ...) added: what the LM
   // loop needs for the model decrease of a step.
   double damping_quadratic(const double* x, double radius, double min_diagonal, double max_diagonal) const;
@@ -142,6 +147,8 @@ class SchurComplement {
   static int runs_cost(const std::vector<ColumnRun>& runs);
   static std::vector<ColumnRun> merge_runs(std::vector<ColumnRun> runs, int local_count);
   void accumulate_gathered(int slot, int f, double* gradient);
+  // reduced_rhs_ = S^-1 reduced_rhs_ with the last factorisation of S.
+  void solve_reduced();
   SchurComplement(const BlockJacobian& jacobian, const std::vector<int>& group_of, int group_count);
 
   const BlockJacobian& jacobian_;

@@ -14,6 +14,9 @@ namespace {
 // Cost of row j under the loss; scales the row and its Jacobian rows.
 double robustify_row(const Loss& loss, int j, double* residual, double* const* jacobians,
                      std::span<const int> block_dims) {
+  // Where the loss is quadratic (on clean data nearly every row) the row
+  // stays as it is and costs what cost() would give, bit for bit.
+  if (loss.quadratic_at(residual[j])) return 0.5 * residual[j] * residual[j];
   const double cost = loss.cost(residual[j]);
   const double scale = loss.scale(residual[j]);
   if (scale == 1.0) return cost;
@@ -41,6 +44,8 @@ double apply_loss_to_rows(const Loss& loss, std::span<const int> robust_rows, in
   double cost = 0.0;
   for (int j = 0; j < residual_dim; ++j) cost += 0.5 * residual[j] * residual[j];
   for (int j : robust_rows) {
+    // A quadratic row would add robustify_row's 0.5 r^2 less the same 0.5 r^2: +0.
+    if (loss.quadratic_at(residual[j])) continue;
     const double squared = 0.5 * residual[j] * residual[j];
     cost += robustify_row(loss, j, residual, jacobians, block_dims) - squared;
   }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 
 #include "solver/linalg/normal_equations.h"
@@ -46,10 +47,14 @@ class LinearSystem {
   virtual LinearSystemKind kind() const = 0;
   virtual int columns() const = 0;
   virtual int variable_column(int v) const = 0;
+  virtual const Linearization& linearization() const = 0;
   virtual bool evaluate(const double* state, int slot, double* cost, int* failed_factor) = 0;
   virtual void accumulate(int slot, double* gradient) = 0;
   virtual FactorizationStatus factorize(double radius, std::string* message) = 0;
   virtual void solve(const double* b, double* x) = 0;
+  // As solve() for a b that is zero before column `first`, where only x
+  // from `first` on is wanted (a covariance of global variables).
+  virtual void solve_tail(int /*first*/, const double* b, double* x) { solve(b, x); }
   virtual double damping_quadratic(const double* x, double radius) = 0;
 };
 
@@ -69,6 +74,7 @@ class FullSystem final : public LinearSystem {
   LinearSystemKind kind() const override { return LinearSystemKind::kFull; }
   int columns() const override { return equations_.columns(); }
   int variable_column(int v) const override { return equations_.variable_column(v); }
+  const Linearization& linearization() const override { return *linearization_; }
   bool evaluate(const double* state, int slot, double* cost, int* failed_factor) override {
     return linearization_->evaluate(state, slot, cost, failed_factor);
   }
@@ -106,6 +112,7 @@ class ReducedSystem final : public LinearSystem {
   LinearSystemKind kind() const override { return LinearSystemKind::kPosesEliminated; }
   int columns() const override { return schur_->columns(); }
   int variable_column(int v) const override { return schur_->variable_column(v); }
+  const Linearization& linearization() const override { return *linearization_; }
   bool evaluate(const double* state, int slot, double* cost, int* failed_factor) override {
     return linearization_->evaluate(state, slot, cost, failed_factor);
   }
@@ -114,6 +121,13 @@ class ReducedSystem final : public LinearSystem {
     return schur_->factorize(radius, kMinDiagonal, kMaxDiagonal, message);
   }
   void solve(const double* b, double* x) override { schur_->solve(b, x); }
+  // Global columns alone need the reduced system alone: b's pose part is
+  // zero, so eliminating it changes nothing, and the poses' back
+  // substitution is not wanted.
+  void solve_tail(int first, const double* b, double* x) override {
+    if (first < schur_->local_columns()) return schur_->solve(b, x);
+    schur_->solve_global(b + schur_->local_columns(), x + schur_->local_columns());
+  }
   double damping_quadratic(const double* x, double radius) override {
     return schur_->damping_quadratic(x, radius, kMinDiagonal, kMaxDiagonal);
   }
@@ -148,6 +162,12 @@ struct LevenbergMarquardt::Impl {
   // memory).
   std::vector<int> column_of;
   int slot = 0;  // linearisation slot of the current point
+  // Where the factors were last evaluated into `slot` (by solve() or
+  // covariance()), and the cost there; `linearized` is false before.
+  bool linearized = false;
+  double linearized_cost = 0.0;
+  std::vector<double> linearized_state;
+  bool reuse_next = false;  // reuse_last_linearization() was called
 
   Impl(Problem& p, SolverOptions o)
       : problem(p), options(std::move(o)), system(make_system(p, options.eliminate_poses)) {
@@ -156,6 +176,7 @@ struct LevenbergMarquardt::Impl {
     step.assign(n, 0.0);
     rhs.assign(n, 0.0);
     candidate.assign(p.state().size(), 0.0);
+    linearized_state.assign(p.state().size(), 0.0);
     for (std::size_t v = 0; v < p.variables().size(); ++v) {
       column_of.push_back(system->variable_column(static_cast<int>(v)));
     }
@@ -188,6 +209,34 @@ struct LevenbergMarquardt::Impl {
     }
   }
 
+  // Whether the caller vouched for the linearisation in `slot` and it is
+  // of the current values, bit for bit; the vouching is used up.
+  bool take_last_linearization() {
+    const bool reuse = reuse_next && linearized && problem.state().size() == linearized_state.size() &&
+                       std::memcmp(problem.state().data(), linearized_state.data(),
+                                   linearized_state.size() * sizeof(double)) == 0;
+    reuse_next = false;
+    return reuse;
+  }
+  void note_linearized(double cost) {
+    linearized = true;
+    linearized_cost = cost;
+    std::copy(problem.state().begin(), problem.state().end(), linearized_state.begin());
+  }
+  // Evaluates the factors at the current values into `slot` and accumulates
+  // J^T J and the gradient, unless the last linearisation may be taken.
+  bool linearize(double* cost, int* failed) {
+    if (take_last_linearization()) {
+      *cost = linearized_cost;
+      return true;
+    }
+    linearized = false;
+    if (!system->evaluate(problem.state().data(), slot, cost, failed)) return false;
+    system->accumulate(slot, gradient.data());
+    note_linearized(*cost);
+    return true;
+  }
+
   SolverSummary solve();
 };
 
@@ -197,7 +246,7 @@ SolverSummary LevenbergMarquardt::Impl::solve() {
 
   int failed = -1;
   double cost = 0.0;
-  if (!system->evaluate(problem.state().data(), slot, &cost, &failed)) {
+  if (!linearize(&cost, &failed)) {
     summary.termination = TerminationType::kNotEvaluable;
     const auto keys = problem.factors()[failed]->keys();
     summary.message = "factor " + std::to_string(failed) + " (first variable " +
@@ -205,7 +254,6 @@ SolverSummary LevenbergMarquardt::Impl::solve() {
                       ") cannot be evaluated at the initial point";
     return summary;
   }
-  system->accumulate(slot, gradient.data());
   summary.initial_cost = summary.final_cost = cost;
 
   IterationSummary it;
@@ -288,6 +336,8 @@ SolverSummary LevenbergMarquardt::Impl::solve() {
     if (options.progress) options.progress(it);
   }
 
+  // `slot` holds the factors at the values the loop leaves.
+  note_linearized(cost);
   summary.iterations = iteration;
   summary.final_cost = cost;
   char buffer[160];
@@ -340,6 +390,13 @@ void LevenbergMarquardt::set_max_iterations(int max_iterations) { impl_->options
 
 SolverSummary LevenbergMarquardt::solve() { return impl_->solve(); }
 
+void LevenbergMarquardt::reuse_last_linearization() { impl_->reuse_next = true; }
+
+std::span<const double> LevenbergMarquardt::last_residuals(int factor) const {
+  if (!impl_->linearized) return {};
+  return impl_->system->linearization().jacobian().residual_values(impl_->slot, factor);
+}
+
 LinearSystemKind LevenbergMarquardt::linear_system() const { return impl_->system->kind(); }
 
 Eigen::MatrixXd LevenbergMarquardt::covariance(const std::vector<Key>& keys) {
@@ -354,18 +411,18 @@ Eigen::MatrixXd LevenbergMarquardt::covariance(const std::vector<Key>& keys) {
   }
   int failed = -1;
   double cost = 0.0;
-  if (s.system->columns() == 0 || !s.system->evaluate(s.problem.state().data(), s.slot, &cost, &failed)) return {};
-  s.system->accumulate(s.slot, s.gradient.data());
+  if (s.system->columns() == 0 || !s.linearize(&cost, &failed)) return {};
   if (s.system->factorize(std::numeric_limits<double>::infinity(), nullptr) != FactorizationStatus::kSuccess) {
     return {};
   }
 
   const int n = static_cast<int>(columns.size());
+  const int first = n > 0 ? *std::min_element(columns.begin(), columns.end()) : 0;
   Eigen::MatrixXd result(n, n);
   std::vector<double> unit(s.system->columns(), 0.0), x(s.system->columns());
   for (int j = 0; j < n; ++j) {
     unit[columns[j]] = 1.0;
-    s.system->solve(unit.data(), x.data());
+    s.system->solve_tail(first, unit.data(), x.data());
     unit[columns[j]] = 0.0;
     for (int i = 0; i < n; ++i) result(i, j) = x[columns[i]];
   }

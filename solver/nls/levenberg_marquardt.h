@@ -22,6 +22,7 @@
 
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -94,6 +95,17 @@ class LevenbergMarquardt {
   // The iteration limit of the next solve() calls (calibrate() shares one
   // budget among the stages of its robust fit).
   void set_max_iterations(int max_iterations);
+
+  // solve() and covariance() first evaluate the factors at the current
+  // values. A caller that knows the factors would give, bit for bit, what
+  // they gave where the last solve() ended (the values unchanged since, and
+  // a loss switched since inactive at every residual there) can spare that:
+  // the next solve() or covariance() takes that linearisation as it is.
+  // The factors are evaluated anyway when the values have changed.
+  void reuse_last_linearization();
+  // Factor `factor`'s residuals (whitened, after its loss) where the last
+  // solve() ended; empty when it could not evaluate its start.
+  std::span<const double> last_residuals(int factor) const;
 
   // Which linear system the constructor chose for this problem.
   LinearSystemKind linear_system() const;

@@ -2,6 +2,8 @@
 // Robust loss on whitened scalar residuals. Belongs to the factor (docs/STYLE.md):
 // the LM loop only sees already-corrected residuals, Jacobians and costs.
 
+#include <cmath>
+
 namespace cdpr {
 
 enum class LossKind {
@@ -17,6 +19,17 @@ struct LossFunction {
 
   double cost(double r) const;   // 0.5 * rho(r^2)
   double scale(double r) const;  // sqrt(rho'(r^2))
+  // Whether cost(r) is 0.5 * r * r, rounded alike, and scale(r) is 1: the
+  // loss leaves r and its Jacobian row as least squares would. Inline: the
+  // factors ask it of every reading row at every evaluation.
+  bool quadratic_at(double r) const {
+    switch (kind) {
+      case LossKind::kHuber: return !(width > 0.0) || std::abs(r) <= width;
+      case LossKind::kCauchy: return !(width > 0.0);
+      case LossKind::kSquared: return true;
+    }
+    return false;
+  }
 };
 
 struct Loss {
@@ -35,6 +48,9 @@ struct Loss {
   // squares, whose fixed points are the loss's stationary points).
   double cost(double r) const;
   double scale(double r) const;
+  bool quadratic_at(double r) const {
+    return shared ? shared->quadratic_at(r) : !(huber_width > 0.0) || std::abs(r) <= huber_width;
+  }
 };
 
 }  // namespace cdpr

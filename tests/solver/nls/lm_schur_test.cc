@@ -3,6 +3,9 @@
 // solution, same covariance; and when the elimination is (not) chosen.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <tuple>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -162,6 +165,48 @@ TEST(LevenbergMarquardtSchur, CovarianceIsTheDenseInverseOfTheInformationMatrix)
   }
   ASSERT_EQ(covariance.rows(), 9);
   EXPECT_LT((covariance - expected).norm(), 1e-9 * expected.norm());
+}
+
+TEST(LevenbergMarquardtSchur, TheLastLinearisationGivesTheSameCovarianceBits) {
+  // GIVEN a solved calibration-shaped problem with the poses eliminated
+  Problem problem = calibration_like(10, false);
+  LevenbergMarquardt lm(problem, {});
+  ASSERT_TRUE(lm.solve().usable());
+  // WHEN the covariance of global variables is asked with the factors
+  // evaluated again, then from the last linearisation, then with a pose
+  // among them (the whole system solved, not only the reduced one)
+  const std::vector<Key> globals = {AnchorKey(0), OffsetKey(0), AnchorKey(2)};
+  const Eigen::MatrixXd evaluated = lm.covariance(globals);
+  lm.reuse_last_linearization();
+  const Eigen::MatrixXd reused = lm.covariance(globals);
+  const Eigen::MatrixXd with_pose = lm.covariance({AnchorKey(0), OffsetKey(0), AnchorKey(2), PoseKey(3)});
+  // THEN the globals' block is the same to the bit each time
+  ASSERT_EQ(evaluated.rows(), 7);
+  EXPECT_EQ(std::memcmp(evaluated.data(), reused.data(), sizeof(double) * evaluated.size()), 0);
+  const Eigen::MatrixXd block = with_pose.topLeftCorner(7, 7);
+  EXPECT_EQ(std::memcmp(evaluated.data(), block.data(), sizeof(double) * evaluated.size()), 0);
+}
+
+TEST(LevenbergMarquardtSchur, ASolveFromTheLastLinearisationTakesTheSameSteps) {
+  // GIVEN a problem solved for two iterations, then solved on, the
+  // second solve evaluating its start again or taking the last
+  // linearisation; and one whose values were moved before that
+  auto second_solve = [](bool reuse, bool move) {
+    Problem problem = calibration_like(10, false);
+    SolverOptions options;
+    options.max_iterations = 2;
+    LevenbergMarquardt lm(problem, options);
+    lm.solve();
+    if (move) problem.state()[0] += 1e-3;
+    lm.set_max_iterations(100);
+    if (reuse) lm.reuse_last_linearization();
+    const SolverSummary summary = lm.solve();
+    return std::make_tuple(summary.iterations, summary.initial_cost, summary.final_cost, problem.state());
+  };
+  // THEN the iterations, costs and values are the same to the bit (values
+  // moved since are evaluated anyway)
+  EXPECT_EQ(second_solve(true, false), second_solve(false, false));
+  EXPECT_EQ(second_solve(true, true), second_solve(false, true));
 }
 
 }  // namespace

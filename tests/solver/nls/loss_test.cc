@@ -70,5 +70,26 @@ TEST(Loss, SharedLossFollowsItsFunction) {
   EXPECT_DOUBLE_EQ(loss.scale(10.0), 1.0);
 }
 
+TEST(Loss, QuadraticWhereItLeavesTheResidualAsLeastSquares) {
+  // GIVEN Huber of width 2, Cauchy of width 2, and plain least squares
+  const LossFunction huber{LossKind::kHuber, 2.0}, cauchy{LossKind::kCauchy, 2.0}, squared{};
+  for (double r : {-3.0, -2.0, -0.5, 0.0, 1.5, 2.0, 2.5}) {
+    // THEN Huber is quadratic within its width, least squares everywhere,
+    // Cauchy nowhere; where quadratic, cost and scale are least squares' to the bit
+    EXPECT_EQ(huber.quadratic_at(r), std::abs(r) <= 2.0) << r;
+    EXPECT_TRUE(squared.quadratic_at(r));
+    EXPECT_FALSE(cauchy.quadratic_at(r));
+    for (const LossFunction* loss : {&huber, &squared}) {
+      if (!loss->quadratic_at(r)) continue;
+      EXPECT_EQ(loss->cost(r), 0.5 * r * r);
+      EXPECT_EQ(loss->scale(r), 1.0);
+    }
+  }
+  // and a Loss without a shared function is a Huber of its width
+  EXPECT_TRUE(Loss{0.0}.quadratic_at(1e6));
+  EXPECT_FALSE(Loss{2.0}.quadratic_at(2.5));
+  EXPECT_TRUE((Loss{0.0, &huber}.quadratic_at(1.5)));
+}
+
 }  // namespace
 }  // namespace cdpr
