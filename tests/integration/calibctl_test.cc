@@ -24,6 +24,7 @@
 #include "calibctl/json_value.h"
 #include "src/control/control_response.h"
 #include "src/daemon/control_server.h"
+#include "../text_contains.h"
 
 namespace cdpr::integration {
 namespace {
@@ -130,7 +131,7 @@ class StubDaemon {
   std::thread thread_;
 };
 
-bool contains(const std::string& text, const std::string& words) { return text.find(words) != std::string::npos; }
+using ::cdpr::test::contains;
 
 TEST(Calibctl, JsonBeforeOrAfterTheSubcommandPrintsTheDaemonsObject) {
   // GIVEN a daemon's control socket

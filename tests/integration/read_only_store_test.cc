@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "virtual_robot_process.h"
+#include "../text_contains.h"
 
 namespace cdpr::integration {
 namespace {
@@ -44,7 +45,7 @@ bool remount(pid_t pid, const std::string& dir, const char* mode) {
   return std::system(command.c_str()) == 0;
 }
 
-bool contains(const std::string& text, const std::string& words) { return text.find(words) != std::string::npos; }
+using ::cdpr::test::contains;
 
 TEST(ReadOnlyStore, ReadOnlyFromTheStartTheRunIsRefusedBeforeAnythingMoves) {
   if (!mount_namespaces_allowed()) GTEST_SKIP() << "mount namespaces are not allowed here";

@@ -25,7 +25,7 @@ class DaemonFiles {
   DaemonFiles() {
     char pattern[] = "/tmp/cdpr-instance-XXXXXX";
     dir = mkdtemp(pattern);
-    std::ofstream(dir + "/robot.toml") << formats::format_robot_toml(test::large_robot());
+    std::ofstream(dir + "/robot.toml") << formats::format_robot_toml(cdpr::test::large_robot());
   }
   ~DaemonFiles() { std::filesystem::remove_all(dir); }
 

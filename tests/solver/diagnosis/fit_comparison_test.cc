@@ -39,11 +39,9 @@ Fits fit_both(const sim::DatasetConfig& config, Effect term, double stated = 1.0
   return fits;
 }
 
-sim::DatasetConfig large_robot(std::uint64_t seed) { return test::large_robot_45_poses(seed); }
-
 TEST(FitComparison, AHiddenElasticityIsFarBeyondChance) {
   // GIVEN cables with EA = 1.5e6 N
-  sim::DatasetConfig config = large_robot(2);
+  sim::DatasetConfig config = test::large_robot_45_poses(2);
   config.effects.axial_stiffness_n = 1.5e6;
   // WHEN the catenary fit is compared with the fit with elasticity
   const Fits f = fit_both(config, Effect::kElasticity);
@@ -57,7 +55,7 @@ TEST(FitComparison, AHiddenElasticityIsFarBeyondChance) {
 
 TEST(FitComparison, ATermTheDataDoNotHoldIsNotSignificant) {
   // GIVEN data without any effect, WHEN a 4-parameter term is added
-  const Fits f = fit_both(large_robot(3), Effect::kEncoderScale);
+  const Fits f = fit_both(test::large_robot_45_poses(3), Effect::kEncoderScale);
   const FitComparison c = compare_fits(f.base, f.with_term);
   // THEN it fits a little noise (chi2 drop of about its 4 parameters) and p is not small
   ASSERT_TRUE(c.comparable) << c.why_not;
@@ -70,7 +68,7 @@ TEST(FitComparison, ATermTheDataDoNotHoldIsNotSignificant) {
 TEST(FitComparison, NoiseLargerThanRobotTomlSaysScalesTheDropDown) {
   // GIVEN sensor noise twice what robot.toml states, and no effect
   // WHEN a 4-parameter term is added
-  const Fits f = fit_both(large_robot(3), Effect::kEncoderScale, 0.5);
+  const Fits f = fit_both(test::large_robot_45_poses(3), Effect::kEncoderScale, 0.5);
   const FitComparison c = compare_fits(f.base, f.with_term);
   // THEN the drop is judged against the measured misfit (chi2 / dof near 4),
   // not the stated sigma, and the term that only fits noise stays insignificant
@@ -81,7 +79,7 @@ TEST(FitComparison, NoiseLargerThanRobotTomlSaysScalesTheDropDown) {
 }
 
 TEST(FitComparison, RefusesFitsItCannotCompare) {
-  const Fits f = fit_both(large_robot(3), Effect::kElasticity);
+  const Fits f = fit_both(test::large_robot_45_poses(3), Effect::kElasticity);
   // GIVEN the larger model as the smaller one: it adds no parameter
   EXPECT_FALSE(compare_fits(f.with_term, f.base).comparable);
   // GIVEN fits that kept different samples
@@ -97,7 +95,7 @@ TEST(FitComparison, RefusesFitsItCannotCompare) {
 
 TEST(AkaikeGain, RanksModelsByTheirDropLessTwoPerParameter) {
   // GIVEN the catenary fit and the fit with a 4-parameter term on data without it
-  const Fits f = fit_both(large_robot(3), Effect::kEncoderScale);
+  const Fits f = fit_both(test::large_robot_45_poses(3), Effect::kEncoderScale);
   // WHEN Akaike's criterion compares them either way
   const double drop = 2.0 * (f.base.solver.final_cost - f.with_term.solver.final_cost);
   // THEN it is the chi2 drop less 2 per parameter added, and its negative the other way round
@@ -109,7 +107,7 @@ TEST(AkaikeGain, RanksModelsByTheirDropLessTwoPerParameter) {
 
 TEST(AkaikeGain, AHiddenTermIsTheBetterModel) {
   // GIVEN cables with EA = 1.5e6 N, WHEN the catenary fit is compared with the fit with elasticity
-  sim::DatasetConfig config = large_robot(2);
+  sim::DatasetConfig config = test::large_robot_45_poses(2);
   config.effects.axial_stiffness_n = 1.5e6;
   const Fits f = fit_both(config, Effect::kElasticity);
   // THEN the elasticity model gains
@@ -117,7 +115,7 @@ TEST(AkaikeGain, AHiddenTermIsTheBetterModel) {
 }
 
 TEST(AkaikeGain, FitsOfDifferentSamplesOrFailedFitsNeverGain) {
-  const Fits f = fit_both(large_robot(3), Effect::kElasticity);
+  const Fits f = fit_both(test::large_robot_45_poses(3), Effect::kElasticity);
   CalibrationResult fewer = f.with_term;
   fewer.rejected_samples.push_back(7);
   EXPECT_EQ(akaike_gain(f.base, fewer), -std::numeric_limits<double>::infinity());

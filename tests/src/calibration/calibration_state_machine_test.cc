@@ -10,13 +10,14 @@
 
 #include "calibration_rig.h"
 #include "src/formats/calibration_toml.h"
+#include "../../text_contains.h"
 
 namespace cdpr::calibration {
 namespace {
 
 using test::CalibrationRig;
 
-bool contains(const std::string& text, const std::string& words) { return text.find(words) != std::string::npos; }
+using ::cdpr::test::contains;
 
 // The common end of every fault test.
 void expect_failed_safely(const CalibrationRig& rig, const std::string& reason_words) {

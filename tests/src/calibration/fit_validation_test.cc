@@ -34,7 +34,7 @@ bool has_reason(const ValidationResult& validation, const std::string& words) {
 
 TEST(FitValidation, AFitAtTheNoiseLevelIsAccepted) {
   // GIVEN a converged fit with residuals at one sigma
-  const Robot robot = test::large_robot();
+  const Robot robot = cdpr::test::large_robot();
   // WHEN validated without a previous calibration
   const ValidationResult validation = validate_fit(good_result(robot), robot, nullptr, {});
   // THEN it is accepted
@@ -42,7 +42,7 @@ TEST(FitValidation, AFitAtTheNoiseLevelIsAccepted) {
 }
 
 TEST(FitValidation, AFailedOrUnconvergedSolveIsRefused) {
-  const Robot robot = test::large_robot();
+  const Robot robot = cdpr::test::large_robot();
   // GIVEN a failed solve and one that ran out of iterations
   CalibrationResult failed = good_result(robot);
   failed.ok = false;
@@ -61,7 +61,7 @@ TEST(FitValidation, AFailedOrUnconvergedSolveIsRefused) {
 
 TEST(FitValidation, ResidualsAboveThreeSigmaAreRefused) {
   // GIVEN encoder residuals at 3.5 sigma and force residuals at 4 sigma
-  const Robot robot = test::large_robot();
+  const Robot robot = cdpr::test::large_robot();
   CalibrationResult result = good_result(robot);
   result.calibration.fit.rms_encoder_m = 3.5 * robot.noise.encoder_m;
   result.calibration.fit.rms_force_n = 4.0 * robot.noise.force_n;
@@ -75,7 +75,7 @@ TEST(FitValidation, ResidualsAboveThreeSigmaAreRefused) {
 
 TEST(FitValidation, LargeSigmasAndNonFiniteValuesAreRefusedPerCable) {
   // GIVEN cable 1 poorly observed and cable 3 with a NaN offset
-  const Robot robot = test::large_robot();
+  const Robot robot = cdpr::test::large_robot();
   CalibrationResult result = good_result(robot);
   result.calibration.winches[1].anchor_sigma.z() = 0.2;
   result.calibration.winches[1].offset_sigma_m = 0.3;
@@ -90,7 +90,7 @@ TEST(FitValidation, LargeSigmasAndNonFiniteValuesAreRefusedPerCable) {
 
 TEST(FitValidation, AnAnchorJumpFromThePreviousCalibrationIsRefused) {
   // GIVEN a previous calibration and a new fit that moves anchor 2 by 0.8 m
-  const Robot robot = test::large_robot();
+  const Robot robot = cdpr::test::large_robot();
   const CalibrationResult previous = good_result(robot);
   CalibrationResult result = good_result(robot);
   result.calibration.winches[2].anchor_world.x() += 0.8;
@@ -102,7 +102,7 @@ TEST(FitValidation, AnAnchorJumpFromThePreviousCalibrationIsRefused) {
 }
 
 TEST(FitValidation, TooFewSamplesOrAWrongCableCountIsRefused) {
-  const Robot robot = test::large_robot();
+  const Robot robot = cdpr::test::large_robot();
   // GIVEN a fit from 6 samples and one with 3 cables
   CalibrationResult few = good_result(robot);
   few.calibration.samples = 6;

@@ -15,6 +15,7 @@
 #include "src/formats/calibration_toml.h"
 #include "src/formats/samples_csv.h"
 #include "src/store/pending_calibration.h"
+#include "../../text_contains.h"
 
 namespace cdpr::calibration {
 namespace {
@@ -22,7 +23,7 @@ namespace {
 using store::test::BrokenDirectory;
 using test::CalibrationRig;
 
-bool contains(const std::string& text, const std::string& words) { return text.find(words) != std::string::npos; }
+using ::cdpr::test::contains;
 
 std::string ask(CalibrationRig& rig, const std::string& line) {
   return control::respond(line, *rig.machine, rig.store, rig.clock.now_us());

@@ -27,7 +27,7 @@ const std::array<double, kCableCount> kOffsets{1.5, -2.0, 0.25, 3.0};
 
 TEST(WaypointPlanner, InformativeSelectionDeterminesAnchorsAndOffsetsBetterThanSpread) {
   // GIVEN the large robot, its workspace and limits
-  const Robot robot = test::large_robot();
+  const Robot robot = cdpr::test::large_robot();
   PlannerOptions spread = large_options(), informative = large_options();
   informative.selection = WaypointSelection::kInformative;
   // WHEN 35 waypoints are picked from the same candidates both ways
@@ -53,7 +53,7 @@ TEST(WaypointPlanner, InformativeSelectionDeterminesAnchorsAndOffsetsBetterThanS
 
 TEST(WaypointPlanner, PlansWellSpreadWaypointsInsideTheLimits) {
   // GIVEN the large robot and its workspace options
-  const Robot robot = test::large_robot();
+  const Robot robot = cdpr::test::large_robot();
   const PlannerOptions options = large_options();
   // WHEN 35 waypoints are planned
   const WaypointPlan plan = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), options);
@@ -86,7 +86,7 @@ TEST(WaypointPlanner, PlansWellSpreadWaypointsInsideTheLimits) {
 
 TEST(WaypointPlanner, SameSeedSamePlan) {
   // GIVEN the same inputs twice
-  const Robot robot = test::large_robot();
+  const Robot robot = cdpr::test::large_robot();
   // WHEN planned twice
   const WaypointPlan a = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), large_options());
   const WaypointPlan b = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), large_options());
@@ -97,7 +97,7 @@ TEST(WaypointPlanner, SameSeedSamePlan) {
 
 TEST(WaypointPlanner, CandidatesOverTheTensionLimitAreRejectedWithTheReason) {
   // GIVEN a maximum tension that the low, wide poses exceed
-  const Robot robot = test::large_robot();
+  const Robot robot = cdpr::test::large_robot();
   PlannerOptions options = large_options();
   options.max_tension_n = 400.0;
   options.waypoint_count = 5;
@@ -113,7 +113,7 @@ TEST(WaypointPlanner, CandidatesOverTheTensionLimitAreRejectedWithTheReason) {
 
 TEST(WaypointPlanner, PayoutLimitsRejectFarCandidatesAndTooFewFeasibleIsAProblem) {
   // GIVEN a maximum payout that only poses near the middle respect
-  const Robot robot = test::large_robot();
+  const Robot robot = cdpr::test::large_robot();
   PlannerOptions options = large_options();
   options.max_payout_m = 160.0;
   options.waypoint_count = 200;
@@ -128,7 +128,7 @@ TEST(WaypointPlanner, PayoutLimitsRejectFarCandidatesAndTooFewFeasibleIsAProblem
 
 TEST(WaypointPlanner, DeepSagPosesAreRejectedAndNoChosenCableSagsBeyondTheLimit) {
   // GIVEN the large robot with the default sag limit, and the same with a limit only a few poses meet
-  const Robot robot = test::large_robot();
+  const Robot robot = cdpr::test::large_robot();
   PlannerOptions options = large_options();
   PlannerOptions tight = options;
   tight.max_sag_excess = 2e-3;
@@ -160,12 +160,12 @@ TEST(WaypointPlanner, AMarginLeavingNoWorkspaceIsRefused) {
   PlannerOptions options = large_options();
   options.margin_m = 150.0;
   // WHEN the options are checked THEN the margin is named
-  EXPECT_NE(check_planner_options(test::large_robot(), options).find("margin"), std::string::npos);
+  EXPECT_NE(check_planner_options(cdpr::test::large_robot(), options).find("margin"), std::string::npos);
 }
 
 TEST(WaypointPlanner, OffsetsEstimatedAtARestPoseAreRecovered) {
   // GIVEN encoder readings of the modelled rest pose plus known offsets
-  const Robot robot = test::large_robot();
+  const Robot robot = cdpr::test::large_robot();
   const Eigen::Vector3d position(150.0, 60.0, 12.0);
   const auto rest = solve_static_pose(robot, nominal_anchors(robot), position);
   ASSERT_TRUE(rest);

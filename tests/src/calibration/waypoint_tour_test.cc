@@ -12,7 +12,7 @@ namespace {
 
 TEST(WaypointTour, TwoOptNeverLengthensTheNearestNeighbourTourAndVisitsEachOnce) {
   // GIVEN the large robot and a scatter of stops
-  const Robot robot = test::large_robot();
+  const Robot robot = cdpr::test::large_robot();
   const auto anchors = nominal_anchors(robot);
   std::vector<Pose> stops;
   for (int k = 0; k < 30; ++k) {
@@ -33,7 +33,7 @@ TEST(WaypointTour, TwoOptNeverLengthensTheNearestNeighbourTourAndVisitsEachOnce)
 
 TEST(WaypointTour, TravelIsTheLargestCableLengthChange) {
   // GIVEN the large robot; WHEN the platform rises 1 m straight up
-  const Robot robot = test::large_robot();
+  const Robot robot = cdpr::test::large_robot();
   const auto anchors = nominal_anchors(robot);
   const Pose a{Eigen::Vector3d(120, 110, 10), Eigen::Quaterniond::Identity()};
   Pose b = a;

@@ -4,13 +4,14 @@
 
 #include "../calibration/calibration_rig.h"
 #include "../store/store_test_support.h"
+#include "../../text_contains.h"
 
 namespace cdpr::control {
 namespace {
 
 using calibration::test::CalibrationRig;
 
-bool contains(const std::string& text, const std::string& words) { return text.find(words) != std::string::npos; }
+using ::cdpr::test::contains;
 
 std::string ask(CalibrationRig& rig, const std::string& line) {
   const std::string response = respond(line, *rig.machine, rig.store, rig.clock.now_us());

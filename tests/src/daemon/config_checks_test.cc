@@ -87,7 +87,7 @@ TEST(ConfigChecks, EndpointsOfEveryTransportAreAccepted) {
 }
 
 TEST(ConfigChecks, TheWorkspaceAndZBandMustFitTheRobot) {
-  const Robot robot = test::large_robot();  // anchors 240 m x 220 m, 50 m high
+  const Robot robot = cdpr::test::large_robot();  // anchors 240 m x 220 m, 50 m high
   // GIVEN a margin that eats the footprint, and a z band reaching the anchors
   const auto wide = parse_daemon_config("robot = \"r\"\n[waypoints]\nmargin = 130.0\n", "m.toml");
   const auto high = parse_daemon_config("robot = \"r\"\n[waypoints]\nz_max = 55.0\n", "z.toml");

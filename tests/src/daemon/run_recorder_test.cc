@@ -16,6 +16,7 @@
 #include "src/formats/robot_toml.h"
 #include "src/formats/samples_csv.h"
 #include "src/store/atomic_file.h"
+#include "../../text_contains.h"
 
 namespace cdpr::daemon {
 namespace {
@@ -23,7 +24,7 @@ namespace {
 using calibration::CalibrationState;
 using calibration::test::CalibrationRig;
 
-bool contains(const std::string& text, const std::string& words) { return text.find(words) != std::string::npos; }
+using ::cdpr::test::contains;
 
 std::string joined(const std::vector<std::string>& lines) {
   std::string text;

@@ -15,11 +15,12 @@
 #include "../store/store_test_support.h"
 #include "src/formats/robot_toml.h"
 #include "src/formats/samples_csv.h"
+#include "../../text_contains.h"
 
 namespace cdpr::daemon {
 namespace {
 
-bool contains(const std::string& text, const std::string& words) { return text.find(words) != std::string::npos; }
+using ::cdpr::test::contains;
 
 class RefitRig {
  public:
@@ -43,7 +44,7 @@ class RefitRig {
     if (!with_samples_file) return;
     std::vector<Sample> rows;
     for (int k = 0; k < samples; ++k) {
-      rows.push_back(test::sample_at(test::tilted_pose(Eigen::Vector3d(60.0 + 10 * k, 50.0 + 7 * (k % 5), 20.0))));
+      rows.push_back(cdpr::test::sample_at(cdpr::test::tilted_pose(Eigen::Vector3d(60.0 + 10 * k, 50.0 + 7 * (k % 5), 20.0))));
       rows.back().id = k;
     }
     ASSERT_TRUE(history.write(run, store::RunHistory::kSamplesName, formats::format_samples_csv(rows)));
@@ -61,7 +62,7 @@ class RefitRig {
   }
 
   store::test::TempStateDir dir;
-  Robot robot = test::large_robot();
+  Robot robot = cdpr::test::large_robot();
   store::CalibrationStore store;
   store::RunHistory history;
   std::vector<std::string> log;
@@ -74,7 +75,7 @@ TEST(RunRefitter, RequestsThatCannotBeServedAreRefusedWithTheirReason) {
   EXPECT_TRUE(contains(r.refused(0, "load_cell_bias"), "no run is kept in " + r.store.history_dir()));
   r.keep_run(1, 0, r.robot, false);
   r.keep_run(2, 0, r.robot);
-  Robot other = test::small_robot();
+  Robot other = cdpr::test::small_robot();
   r.keep_run(3, 12, other);
   // WHEN refits are asked for THEN each refusal names what is wrong
   EXPECT_EQ(r.refused(1, "bias"),

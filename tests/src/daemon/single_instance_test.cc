@@ -20,13 +20,14 @@
 #include "../store/store_test_support.h"
 #include "src/daemon/control_server.h"
 #include "src/daemon/instance_lock.h"
+#include "../../text_contains.h"
 
 namespace cdpr::daemon {
 namespace {
 
 using store::test::TempStateDir;
 
-bool contains(const std::string& text, const std::string& words) { return text.find(words) != std::string::npos; }
+using ::cdpr::test::contains;
 
 std::string echo(std::string_view line) { return std::string(line) + "\n"; }
 

@@ -12,7 +12,7 @@ namespace {
 
 // The robot.toml example of docs/FORMATS.md, verbatim but for three more winches
 // (the solver needs four cables).
-const std::string kExample = R"(name = "large"                     # free text
+const std::string kRobotExample = R"(name = "large"                     # free text
 gravity = 9.81                     # m/s^2, optional, default 9.81
 
 [platform]
@@ -50,9 +50,9 @@ orientation = 0.01                 # rad (pose rotation)
 using test::BadEdit;
 using test::line_of;
 
-std::string example_with(const std::string& from, const std::string& to) { return test::replaced(kExample, from, to); }
+std::string robot_example_with(const std::string& from, const std::string& to) { return test::replaced(kRobotExample, from, to); }
 
-FormatError parse_error(const std::string& text) {
+FormatError robot_parse_error(const std::string& text) {
   const auto robot = parse_robot_toml(text, "robot.toml");
   EXPECT_FALSE(robot.has_value());
   return robot ? FormatError{} : robot.error();
@@ -61,7 +61,7 @@ FormatError parse_error(const std::string& text) {
 TEST(RobotToml, ExampleOfFormatsMdParses) {
   // GIVEN the documented example
   // WHEN it is parsed
-  const auto robot = parse_robot_toml(kExample, "robot.toml");
+  const auto robot = parse_robot_toml(kRobotExample, "robot.toml");
   // THEN every documented value arrives in the Robot
   ASSERT_TRUE(robot.has_value()) << robot.error().message();
   EXPECT_EQ(robot->name, "large");
@@ -83,9 +83,9 @@ TEST(RobotToml, ExampleOfFormatsMdParses) {
 
 TEST(RobotToml, UnknownKeyIsNamedWithItsLineAndASuggestion) {
   // GIVEN a misspelt key in the third winch table
-  const std::string text = example_with("anchor = [200.0, 200.0, 50.0]", "ancor = [200.0, 200.0, 50.0]");
+  const std::string text = robot_example_with("anchor = [200.0, 200.0, 50.0]", "ancor = [200.0, 200.0, 50.0]");
   // WHEN it is parsed
-  const FormatError error = parse_error(text);
+  const FormatError error = robot_parse_error(text);
   // THEN the error names the dotted key, its line and the key that was meant
   EXPECT_EQ(error.field, "winch[2].ancor");
   EXPECT_EQ(error.line, line_of(text, "ancor"));
@@ -96,10 +96,10 @@ TEST(RobotToml, UnknownKeyIsNamedWithItsLineAndASuggestion) {
 
 TEST(RobotToml, MissingKeysAreAllNamed) {
   // GIVEN [platform] without mass and without center_of_mass
-  std::string text = example_with("mass = 34.0", "");
+  std::string text = robot_example_with("mass = 34.0", "");
   text = text.replace(text.find("center_of_mass"), 14, "# center_of_ma");
   // WHEN it is parsed
-  const FormatError error = parse_error(text);
+  const FormatError error = robot_parse_error(text);
   // THEN both keys are named, at the line of their table
   EXPECT_EQ(error.field, "platform.mass, platform.center_of_mass");
   EXPECT_EQ(error.reason, "missing required keys");
@@ -108,18 +108,18 @@ TEST(RobotToml, MissingKeysAreAllNamed) {
 
 TEST(RobotToml, MissingTopLevelKeyConcernsTheWholeFile) {
   // GIVEN no name
-  const std::string text = example_with("name = \"large\"", "");
+  const std::string text = robot_example_with("name = \"large\"", "");
   // WHEN it is parsed
-  const FormatError error = parse_error(text);
+  const FormatError error = robot_parse_error(text);
   // THEN the key is named and no line is claimed
   EXPECT_EQ(error.message(), "robot.toml: name: missing required key");
 }
 
 TEST(RobotToml, MissingTableIsNamed) {
   // GIVEN no [noise] table at all
-  const std::string text = kExample.substr(0, kExample.find("[noise]"));
+  const std::string text = kRobotExample.substr(0, kRobotExample.find("[noise]"));
   // WHEN it is parsed
-  const FormatError error = parse_error(text);
+  const FormatError error = robot_parse_error(text);
   // THEN the table is named as missing
   EXPECT_EQ(error.field, "noise");
   EXPECT_NE(error.reason.find("missing"), std::string::npos) << error.reason;
@@ -127,9 +127,9 @@ TEST(RobotToml, MissingTableIsNamed) {
 
 TEST(RobotToml, UnknownTableIsRefused) {
   // GIVEN a table this version does not know
-  const std::string text = kExample + "\n[limits]\nmax_tension = 3000.0\n";
+  const std::string text = kRobotExample + "\n[limits]\nmax_tension = 3000.0\n";
   // WHEN it is parsed
-  const FormatError error = parse_error(text);
+  const FormatError error = robot_parse_error(text);
   // THEN it is named with its line
   EXPECT_EQ(error.field, "limits");
   EXPECT_EQ(error.line, line_of(text, "[limits]"));
@@ -138,7 +138,7 @@ TEST(RobotToml, UnknownTableIsRefused) {
 
 TEST(RobotToml, IntegersAreAcceptedForNumbers) {
   // GIVEN a mass and an anchor coordinate written as integers
-  const std::string text = example_with("mass = 34.0", "mass = 34");
+  const std::string text = robot_example_with("mass = 34.0", "mass = 34");
   // WHEN it is parsed
   const auto robot = parse_robot_toml(text, "robot.toml");
   // THEN they read as the same numbers
@@ -148,7 +148,7 @@ TEST(RobotToml, IntegersAreAcceptedForNumbers) {
 
 TEST(RobotToml, IntegersBeyondDoublePrecisionAreStillNumbers) {
   // GIVEN an absurd but valid integer that a double cannot hold exactly (2^53 + 1)
-  const std::string text = example_with("mass = 34.0", "mass = 9007199254740993");
+  const std::string text = robot_example_with("mass = 34.0", "mass = 9007199254740993");
   // WHEN it is parsed
   const auto robot = parse_robot_toml(text, "robot.toml");
   // THEN it reads as the nearest double rather than as an error
@@ -158,7 +158,7 @@ TEST(RobotToml, IntegersBeyondDoublePrecisionAreStillNumbers) {
 
 TEST(RobotToml, OptionalKeysHaveTheirDefaultsOrValues) {
   // GIVEN no gravity line and an axial stiffness
-  std::string text = example_with("gravity = 9.81 ", "# gravity");
+  std::string text = robot_example_with("gravity = 9.81 ", "# gravity");
   text = text.replace(text.find("# axial_stiffness"), 2, "");
   // WHEN it is parsed
   const auto robot = parse_robot_toml(text, "robot.toml");
@@ -174,9 +174,9 @@ class RobotTomlBadValue : public testing::TestWithParam<BadEdit> {};
 TEST_P(RobotTomlBadValue, IsRefusedWithLineKeyAndReason) {
   // GIVEN the example with one value spoilt
   const BadEdit& bad = GetParam();
-  const std::string text = example_with(bad.from, bad.to);
+  const std::string text = robot_example_with(bad.from, bad.to);
   // WHEN it is parsed
-  const FormatError error = parse_error(text);
+  const FormatError error = robot_parse_error(text);
   // THEN the error names the key, the line of the spoilt value and why
   test::expect_refusal(error, bad, text);
 }
@@ -206,10 +206,10 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(RobotToml, WrongWinchCountIsRefusedWithTheCount) {
   // GIVEN only three [[winch]] tables
-  const std::size_t last = kExample.rfind("[[winch]]");
-  const std::string text = kExample.substr(0, last) + kExample.substr(kExample.find("[noise]"));
+  const std::size_t last = kRobotExample.rfind("[[winch]]");
+  const std::string text = kRobotExample.substr(0, last) + kRobotExample.substr(kRobotExample.find("[noise]"));
   // WHEN it is parsed
-  const FormatError error = parse_error(text);
+  const FormatError error = robot_parse_error(text);
   // THEN the error says how many were found and how many are needed
   EXPECT_EQ(error.field, "winch");
   EXPECT_NE(error.reason.find("found 3 [[winch]] tables"), std::string::npos) << error.reason;
@@ -218,19 +218,19 @@ TEST(RobotToml, WrongWinchCountIsRefusedWithTheCount) {
 
 TEST(RobotToml, SingleWinchIsNotACableRobot) {
   // GIVEN one [[winch]] table
-  const std::size_t second = kExample.find("[[winch]]", kExample.find("[[winch]]") + 1);
-  const std::string text = kExample.substr(0, second) + kExample.substr(kExample.find("[noise]"));
+  const std::size_t second = kRobotExample.find("[[winch]]", kRobotExample.find("[[winch]]") + 1);
+  const std::string text = kRobotExample.substr(0, second) + kRobotExample.substr(kRobotExample.find("[noise]"));
   // WHEN it is parsed
-  const FormatError error = parse_error(text);
+  const FormatError error = robot_parse_error(text);
   // THEN the error says at least two are needed
   EXPECT_NE(error.reason.find("at least 2"), std::string::npos) << error.reason;
 }
 
 TEST(RobotToml, SyntaxErrorKeepsTomlsLine) {
   // GIVEN a line that is not TOML
-  const std::string text = example_with("mass = 34.0", "mass = = 34.0");
+  const std::string text = robot_example_with("mass = 34.0", "mass = = 34.0");
   // WHEN it is parsed
-  const FormatError error = parse_error(text);
+  const FormatError error = robot_parse_error(text);
   // THEN the error carries that line and the parser's description
   EXPECT_EQ(error.line, line_of(text, "mass = ="));
   EXPECT_NE(error.reason.find("TOML syntax"), std::string::npos) << error.reason;
@@ -238,7 +238,7 @@ TEST(RobotToml, SyntaxErrorKeepsTomlsLine) {
 
 TEST(RobotToml, FormatThenParseGivesTheSameRobot) {
   // GIVEN a robot with values that need all 17 digits, with and without EA
-  const auto parsed = parse_robot_toml(kExample, "robot.toml");
+  const auto parsed = parse_robot_toml(kRobotExample, "robot.toml");
   ASSERT_TRUE(parsed.has_value());
   Robot robot = *parsed;
   robot.name = "odd \"name\" \\ with\ttab";

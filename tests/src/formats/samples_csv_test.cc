@@ -12,13 +12,13 @@ namespace cdpr::formats {
 namespace {
 
 // The samples.csv example of docs/FORMATS.md plus a second row.
-const std::string kExample =
+const std::string kSamplesExample =
     "# lines starting with '#' are comments\n"
     "sample,x,y,z,qw,qx,qy,qz,enc0,enc1,enc2,enc3,force\n"
     "0,112.31,104.92,12.07,0.9998,0.0031,-0.0152,0.0004,171.233,182.904,166.118,190.451,702.4\n"
     "1,80.5,90.25,10.5,1,0,0,0,150.5,160.25,170.125,180.0625,650\n";
 
-FormatError parse_error(const std::string& text) {
+FormatError samples_parse_error(const std::string& text) {
   const auto samples = parse_samples_csv(text, "samples.csv", kCableCount);
   EXPECT_FALSE(samples.has_value());
   return samples ? FormatError{} : samples.error();
@@ -26,12 +26,12 @@ FormatError parse_error(const std::string& text) {
 
 using test::BadEdit;
 
-std::string example_with(const std::string& from, const std::string& to) { return test::replaced(kExample, from, to); }
+std::string samples_example_with(const std::string& from, const std::string& to) { return test::replaced(kSamplesExample, from, to); }
 
 TEST(SamplesCsv, ExampleOfFormatsMdParses) {
   // GIVEN the documented example
   // WHEN it is parsed
-  const auto samples = parse_samples_csv(kExample, "samples.csv", kCableCount);
+  const auto samples = parse_samples_csv(kSamplesExample, "samples.csv", kCableCount);
   // THEN each row becomes a sample with its values in place
   ASSERT_TRUE(samples.has_value()) << samples.error().message();
   ASSERT_EQ(samples->size(), 2u);
@@ -77,9 +77,9 @@ class SamplesCsvBadInput : public testing::TestWithParam<BadEdit> {};
 TEST_P(SamplesCsvBadInput, IsRefusedWithLineColumnAndReason) {
   // GIVEN the example with one thing spoilt
   const BadEdit& bad = GetParam();
-  const std::string text = example_with(bad.from, bad.to);
+  const std::string text = samples_example_with(bad.from, bad.to);
   // WHEN it is parsed
-  const FormatError error = parse_error(text);
+  const FormatError error = samples_parse_error(text);
   // THEN the error names the file line, the column and why
   EXPECT_EQ(error.file, "samples.csv");
   test::expect_refusal(error, bad, text);
@@ -110,7 +110,7 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(SamplesCsv, QuaternionJustInsideToleranceIsNormalised) {
   // GIVEN a quaternion whose norm is 1.0009
-  const std::string text = example_with("1,0,0,0,150.5", "1.0009,0,0,0,150.5");
+  const std::string text = samples_example_with("1,0,0,0,150.5", "1.0009,0,0,0,150.5");
   // WHEN it is parsed
   const auto samples = parse_samples_csv(text, "samples.csv", kCableCount);
   // THEN it is accepted as a unit quaternion
@@ -120,9 +120,9 @@ TEST(SamplesCsv, QuaternionJustInsideToleranceIsNormalised) {
 
 TEST(SamplesCsv, HeaderWithoutRowsIsRefused) {
   // GIVEN only comments and the header
-  const std::string text = kExample.substr(0, kExample.find("\n0,") + 1);
+  const std::string text = kSamplesExample.substr(0, kSamplesExample.find("\n0,") + 1);
   // WHEN it is parsed
-  const FormatError error = parse_error(text);
+  const FormatError error = samples_parse_error(text);
   // THEN it says there are no data rows, at the header's line
   EXPECT_EQ(error.reason, "no data rows");
   EXPECT_EQ(error.line, 2);
@@ -131,7 +131,7 @@ TEST(SamplesCsv, HeaderWithoutRowsIsRefused) {
 TEST(SamplesCsv, EmptyFileIsRefused) {
   // GIVEN only a comment
   // WHEN it is parsed
-  const FormatError error = parse_error("# nothing here\n");
+  const FormatError error = samples_parse_error("# nothing here\n");
   // THEN it asks for the header and spells it out
   EXPECT_NE(error.reason.find("no header line"), std::string::npos) << error.reason;
   EXPECT_NE(error.reason.find("sample,x,y,z,qw,qx,qy,qz,enc0,enc1,enc2,enc3,force"), std::string::npos);
@@ -140,7 +140,7 @@ TEST(SamplesCsv, EmptyFileIsRefused) {
 TEST(SamplesCsv, OtherCableCountsAreRefused) {
   // GIVEN a request for three cables
   // WHEN the example is parsed
-  const auto samples = parse_samples_csv(kExample, "samples.csv", 3);
+  const auto samples = parse_samples_csv(kSamplesExample, "samples.csv", 3);
   // THEN it is refused naming the counts
   ASSERT_FALSE(samples.has_value());
   EXPECT_NE(samples.error().reason.find("3 cables"), std::string::npos) << samples.error().reason;
@@ -194,22 +194,22 @@ TEST(SamplesCsv, SigmaColumnsAreReadPerRow) {
 }
 
 TEST(SamplesCsv, FileWithoutSigmaColumnsHasNoRowSigmas) {
-  const auto samples = parse_samples_csv(kExample, "samples.csv", kCableCount);
+  const auto samples = parse_samples_csv(kSamplesExample, "samples.csv", kCableCount);
   ASSERT_TRUE(samples.has_value());
   for (const Sample& s : *samples) EXPECT_FALSE(s.has_own_sigma());
 }
 
 TEST(SamplesCsv, SigmaColumnsComeAllTogetherAndPositive) {
   // GIVEN one sigma column missing THEN the header is refused naming it
-  const FormatError missing = parse_error(test::replaced(kWithSigmas, ",sigma_rot", ""));
+  const FormatError missing = samples_parse_error(test::replaced(kWithSigmas, ",sigma_rot", ""));
   EXPECT_EQ(missing.field, "sigma_rot");
   EXPECT_NE(missing.reason.find("all together"), std::string::npos) << missing.reason;
   // GIVEN a row with some sigmas empty THEN the row is refused
-  const FormatError partial = parse_error(test::replaced(kWithSigmas, ",0.0007\n", ",\n"));
+  const FormatError partial = samples_parse_error(test::replaced(kWithSigmas, ",0.0007\n", ",\n"));
   EXPECT_EQ(partial.field, "sigma_rot");
   EXPECT_EQ(partial.line, 2);
   // GIVEN a zero sigma THEN refused
-  const FormatError zero = parse_error(test::replaced(kWithSigmas, ",0.5,", ",0,"));
+  const FormatError zero = samples_parse_error(test::replaced(kWithSigmas, ",0.5,", ",0,"));
   EXPECT_EQ(zero.field, "sigma_force");
   EXPECT_NE(zero.reason.find("> 0"), std::string::npos) << zero.reason;
 }

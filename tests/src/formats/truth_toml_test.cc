@@ -9,7 +9,7 @@ namespace cdpr::formats {
 namespace {
 
 // The truth.toml example of docs/FORMATS.md with its effect uncommented and a second winch.
-const std::string kExample = R"([[winch]]
+const std::string kTruthExample = R"([[winch]]
 anchor = [0.0, 0.0, 50.0]          # m, true pulley exit point
 offset = 3.2                       # m, true encoder offset
 
@@ -24,7 +24,7 @@ axial_stiffness = 1.5e6
 TEST(TruthToml, ExampleOfFormatsMdParses) {
   // GIVEN the documented example
   // WHEN it is parsed
-  const auto truth = parse_truth_toml(kExample, "truth.toml");
+  const auto truth = parse_truth_toml(kTruthExample, "truth.toml");
   // THEN winches and effects arrive
   ASSERT_TRUE(truth.has_value()) << truth.error().message();
   ASSERT_EQ(truth->winches.size(), 2u);
@@ -36,7 +36,7 @@ TEST(TruthToml, ExampleOfFormatsMdParses) {
 
 TEST(TruthToml, EffectsAreOptional) {
   // GIVEN no [effects] table
-  const std::string text = kExample.substr(0, kExample.find("[effects]"));
+  const std::string text = kTruthExample.substr(0, kTruthExample.find("[effects]"));
   // WHEN it is parsed
   const auto truth = parse_truth_toml(text, "truth.toml");
   // THEN there are no effects
@@ -46,7 +46,7 @@ TEST(TruthToml, EffectsAreOptional) {
 
 TEST(TruthToml, UnknownKeyIsNamedWithItsLine) {
   // GIVEN a key truth.toml does not have
-  const std::string text = kExample + "[noise]\nencoder = 0.01\n";
+  const std::string text = kTruthExample + "[noise]\nencoder = 0.01\n";
   // WHEN it is parsed
   const auto truth = parse_truth_toml(text, "truth.toml");
   // THEN it is refused with its name and line
@@ -58,7 +58,7 @@ TEST(TruthToml, UnknownKeyIsNamedWithItsLine) {
 TEST(TruthToml, NonNumericEffectIsKeptAsNotCompared) {
   // GIVEN an [effects] key with a boolean and one with a string (evaluation
   // input from another simulator)
-  const std::string text = kExample + "massless = true\nsource = \"fem\"\n";
+  const std::string text = kTruthExample + "massless = true\nsource = \"fem\"\n";
   // WHEN it is parsed
   const auto truth = parse_truth_toml(text, "truth.toml");
   // THEN it is read, the numeric effect compared, the others named as not compared
@@ -69,7 +69,7 @@ TEST(TruthToml, NonNumericEffectIsKeptAsNotCompared) {
 
 TEST(TruthToml, PlantedOutliersRoundTrip) {
   // GIVEN a truth with two planted gross errors
-  auto truth = parse_truth_toml(kExample, "truth.toml");
+  auto truth = parse_truth_toml(kTruthExample, "truth.toml");
   ASSERT_TRUE(truth.has_value());
   truth->outliers = {{3, SensorKind::kEncoder, 2, -1.25}, {7, SensorKind::kForce, 0, 312.5}};
   // WHEN it is formatted and parsed again
@@ -86,7 +86,7 @@ TEST(TruthToml, PlantedOutliersRoundTrip) {
 }
 
 TEST(TruthToml, OutlierWithUnknownSensorIsRefused) {
-  const std::string text = kExample + "\n[[outlier]]\nrow = 1\nsensor = \"pose\"\ncable = 0\nerror = 1.0\n";
+  const std::string text = kTruthExample + "\n[[outlier]]\nrow = 1\nsensor = \"pose\"\ncable = 0\nerror = 1.0\n";
   const auto truth = parse_truth_toml(text, "truth.toml");
   ASSERT_FALSE(truth.has_value());
   EXPECT_EQ(truth.error().field, "outlier[0].sensor");

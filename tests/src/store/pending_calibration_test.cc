@@ -13,6 +13,7 @@
 #include "src/formats/calibration_toml.h"
 #include "store_test_support.h"
 #include "test_broken_directory.h"
+#include "../../text_contains.h"
 
 namespace cdpr::store {
 namespace {
@@ -22,7 +23,7 @@ using test::calibration_version;
 using test::file_bytes;
 using test::TempStateDir;
 
-bool contains(const std::string& text, const std::string& words) { return text.find(words) != std::string::npos; }
+using ::cdpr::test::contains;
 
 class StoreWithHistory {
  public:
