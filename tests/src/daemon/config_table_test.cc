@@ -22,7 +22,7 @@
 namespace cdpr::daemon {
 namespace {
 
-const std::string kExample = std::string(CDPR_SOURCE_DIR) + "/systemd/cdpr-calibd.toml";
+const std::string kShippedExample = std::string(CDPR_SOURCE_DIR) + "/systemd/cdpr-calibd.toml";
 const std::string kDocs = std::string(CDPR_SOURCE_DIR) + "/docs/configuration.md";
 constexpr std::string_view kBegin = "<!-- BEGIN keys: generated from src/daemon/daemon_config.cc -->\n";
 constexpr std::string_view kEnd = "<!-- END keys -->\n";
@@ -62,12 +62,12 @@ TEST(ConfigTable, TheExampleListsExactlyTheTablesKeysInTheirOrder) {
     table_keys.push_back(key.table.empty() ? key.name : key.table + "." + key.name);
   }
   // WHEN the example's keys are listed THEN they are the tables' keys
-  EXPECT_EQ(keys_in_example(text_of(kExample)), table_keys);
+  EXPECT_EQ(keys_in_example(text_of(kShippedExample)), table_keys);
 }
 
 TEST(ConfigTable, TheExampleShowsEveryKeyWithItsDefault) {
   // GIVEN the example WHEN read
-  const auto config = read_daemon_config(kExample);
+  const auto config = read_daemon_config(kShippedExample);
   ASSERT_TRUE(config) << config.error().message();
   // THEN every value equals the tables' default (the robot has none)
   auto values = daemon_config_values(*config);
