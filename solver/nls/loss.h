@@ -49,7 +49,7 @@ struct Loss {
   double cost(double r) const;
   double scale(double r) const;
   bool quadratic_at(double r) const {
-    return shared ? shared->quadratic_at(r) : !(huber_width > 0.0) || std::abs(r) <= huber_width;
+    return shared ? shared->quadratic_at(r) : LossFunction{LossKind::kHuber, huber_width}.quadratic_at(r);
   }
 };
 
