@@ -7,28 +7,18 @@
 #include <gtest/gtest.h>
 
 #include "../../solver/model/test_robots.h"
+#include "large_robot_planner_options.h"
 #include "solver/calibration/pose_design.h"
 
 namespace cdpr::calibration {
 namespace {
-
-PlannerOptions large_options() {
-  PlannerOptions options;
-  options.waypoint_count = 35;
-  options.margin_m = 20.0;
-  options.z_min_m = 5.0;
-  options.z_max_m = 35.0;
-  options.min_tension_n = 20.0;
-  options.max_tension_n = 3000.0;
-  return options;
-}
 
 const std::array<double, kCableCount> kOffsets{1.5, -2.0, 0.25, 3.0};
 
 TEST(WaypointPlanner, InformativeSelectionDeterminesAnchorsAndOffsetsBetterThanSpread) {
   // GIVEN the large robot, its workspace and limits
   const Robot robot = cdpr::test::large_robot();
-  PlannerOptions spread = large_options(), informative = large_options();
+  PlannerOptions spread = large_robot_planner_options(), informative = large_robot_planner_options();
   informative.selection = WaypointSelection::kInformative;
   // WHEN 35 waypoints are picked from the same candidates both ways
   const WaypointPlan a = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), spread);
@@ -54,7 +44,7 @@ TEST(WaypointPlanner, InformativeSelectionDeterminesAnchorsAndOffsetsBetterThanS
 TEST(WaypointPlanner, PlansWellSpreadWaypointsInsideTheLimits) {
   // GIVEN the large robot and its workspace options
   const Robot robot = cdpr::test::large_robot();
-  const PlannerOptions options = large_options();
+  const PlannerOptions options = large_robot_planner_options();
   // WHEN 35 waypoints are planned
   const WaypointPlan plan = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), options);
   // THEN there are 35, inside the box and the limits, with payout = arc length + offset
@@ -88,8 +78,8 @@ TEST(WaypointPlanner, SameSeedSamePlan) {
   // GIVEN the same inputs twice
   const Robot robot = cdpr::test::large_robot();
   // WHEN planned twice
-  const WaypointPlan a = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), large_options());
-  const WaypointPlan b = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), large_options());
+  const WaypointPlan a = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), large_robot_planner_options());
+  const WaypointPlan b = plan_waypoints(robot, kOffsets, Eigen::Vector3d(120, 110, 10), large_robot_planner_options());
   // THEN the plans are identical
   ASSERT_TRUE(a.ok() && b.ok());
   for (std::size_t k = 0; k < a.waypoints.size(); ++k) EXPECT_EQ(a.waypoints[k].payout_m, b.waypoints[k].payout_m);
@@ -98,7 +88,7 @@ TEST(WaypointPlanner, SameSeedSamePlan) {
 TEST(WaypointPlanner, CandidatesOverTheTensionLimitAreRejectedWithTheReason) {
   // GIVEN a maximum tension that the low, wide poses exceed
   const Robot robot = cdpr::test::large_robot();
-  PlannerOptions options = large_options();
+  PlannerOptions options = large_robot_planner_options();
   options.max_tension_n = 400.0;
   options.waypoint_count = 5;
   // WHEN planned
@@ -114,7 +104,7 @@ TEST(WaypointPlanner, CandidatesOverTheTensionLimitAreRejectedWithTheReason) {
 TEST(WaypointPlanner, PayoutLimitsRejectFarCandidatesAndTooFewFeasibleIsAProblem) {
   // GIVEN a maximum payout that only poses near the middle respect
   const Robot robot = cdpr::test::large_robot();
-  PlannerOptions options = large_options();
+  PlannerOptions options = large_robot_planner_options();
   options.max_payout_m = 160.0;
   options.waypoint_count = 200;
   // WHEN planned
@@ -129,7 +119,7 @@ TEST(WaypointPlanner, PayoutLimitsRejectFarCandidatesAndTooFewFeasibleIsAProblem
 TEST(WaypointPlanner, DeepSagPosesAreRejectedAndNoChosenCableSagsBeyondTheLimit) {
   // GIVEN the large robot with the default sag limit, and the same with a limit only a few poses meet
   const Robot robot = cdpr::test::large_robot();
-  PlannerOptions options = large_options();
+  PlannerOptions options = large_robot_planner_options();
   PlannerOptions tight = options;
   tight.max_sag_excess = 2e-3;
   tight.waypoint_count = 1;
@@ -157,7 +147,7 @@ TEST(WaypointPlanner, DeepSagPosesAreRejectedAndNoChosenCableSagsBeyondTheLimit)
 
 TEST(WaypointPlanner, AMarginLeavingNoWorkspaceIsRefused) {
   // GIVEN a margin wider than half the footprint
-  PlannerOptions options = large_options();
+  PlannerOptions options = large_robot_planner_options();
   options.margin_m = 150.0;
   // WHEN the options are checked THEN the margin is named
   EXPECT_NE(check_planner_options(cdpr::test::large_robot(), options).find("margin"), std::string::npos);

@@ -7,29 +7,21 @@
 #include <gtest/gtest.h>
 
 #include "../../solver/model/test_robots.h"
+#include "large_robot_planner_options.h"
 
 namespace cdpr::calibration {
 namespace {
-
-PlannerOptions large_options() {
-  PlannerOptions options;
-  options.margin_m = 20.0;
-  options.z_min_m = 5.0;
-  options.z_max_m = 35.0;
-  options.grid_xy = 4;
-  options.grid_z = 2;
-  options.min_tension_n = 20.0;
-  options.max_tension_n = 3000.0;
-  return options;
-}
 
 TEST(WaypointSequence, AFailedReSolveFallsBackToTheNextSpreadWaypoint) {
   // GIVEN the sequential strategy on the large robot
   const Robot robot = test::large_robot();
   SequentialOptions sequential;
   sequential.max_count = 12;
+  PlannerOptions planner = large_robot_planner_options();
+  planner.grid_xy = 4;
+  planner.grid_z = 2;
   WaypointSequence sequence;
-  ASSERT_EQ(sequence.start(robot, {}, Eigen::Vector3d(120, 110, 10), large_options(), WaypointStrategy::kSequential,
+  ASSERT_EQ(sequence.start(robot, {}, Eigen::Vector3d(120, 110, 10), planner, WaypointStrategy::kSequential,
                            sequential, 0),
             "");
   // WHEN every row is one no fit can start from (a negative tension), so
