@@ -186,7 +186,8 @@ WaypointPlan plan_waypoints(const Robot& robot, const std::array<double, kCableC
                          : spread_waypoints(feasible, 0.5 * (box.low + box.high), options.waypoint_count)) {
     chosen.push_back(feasible[k]);
   }
-  plan.waypoints = travel_order(robot, std::move(chosen), start_world);
+  plan.waypoints =
+      options.order == WaypointOrder::kTour ? travel_order(robot, std::move(chosen), start_world) : std::move(chosen);
   return plan;
 }
 

@@ -49,6 +49,16 @@ enum class WaypointSelection {
   kInformative,
 };
 
+// The order in which a fixed plan is driven.
+enum class WaypointOrder {
+  // A short tour from where the platform starts (waypoint_tour.h): the
+  // robot's time goes to sampling, not to travel.
+  kTour,
+  // As selected (spread: centre first, then outwards by farthest point).
+  // Kept to compare robot times and to repeat a run made in that order.
+  kSelection,
+};
+
 struct PlannerOptions {
   int waypoint_count = 35;
   double margin_m = 5.0;  // inset from the anchors' xy footprint [m]
@@ -64,6 +74,7 @@ struct PlannerOptions {
   double max_payout_m = 1e9;
   double max_sag_excess = 0.02;  // (arc length - chord) / chord, every cable
   WaypointSelection selection = WaypointSelection::kSpread;
+  WaypointOrder order = WaypointOrder::kTour;
 };
 
 struct Waypoint {

@@ -119,6 +119,10 @@ Table<CalibratorOptions> waypoints_table() {
            "a fixed plan of `count` waypoints evenly over the feasible candidates, or those that determine anchors "
            "and offsets best; or sequential: re-solve after each sample, pick the next waypoint by the variance it "
            "removes per second of robot time, stop at the targets");
+  t.choice("order", planner(&PlannerOptions::order),
+           {{"tour", calibration::WaypointOrder::kTour}, {"selection", calibration::WaypointOrder::kSelection}},
+           calibration::WaypointOrder::kTour,
+           "spread, informative: driven as a short tour from where the platform starts, or in the order selected");
   t.integer("count", planner(&PlannerOptions::waypoint_count), 35, {1, 10'000}, "",
             "static poses per calibration (spread, informative)");
   t.number("target_anchor_sigma", [](auto& o) -> auto& { return o.sequential.target_anchor_sigma_m; }, 0.02,

@@ -9,6 +9,7 @@
 #include "../../solver/model/test_robots.h"
 #include "large_robot_planner_options.h"
 #include "solver/calibration/pose_design.h"
+#include "src/calibration/waypoint_tour.h"
 
 namespace cdpr::calibration {
 namespace {
@@ -72,6 +73,41 @@ TEST(WaypointPlanner, PlansWellSpreadWaypointsInsideTheLimits) {
   // AND spread: no two closer than half the spacing of a regular lattice of 35 points in the box
   const double lattice_spacing_m = std::cbrt(200.0 * 180.0 * 30.0 / 35.0);
   EXPECT_GT(min_distance_m, 0.5 * lattice_spacing_m);
+}
+
+TEST(WaypointPlanner, TheSelectionOrderKeepsTheWaypointsAndDropsOnlyTheTour) {
+  // GIVEN the large robot's 35-waypoint spread plan, as a tour and in selection order
+  const Robot robot = cdpr::test::large_robot();
+  const Eigen::Vector3d start(120, 110, 10);
+  PlannerOptions tour = large_robot_planner_options(), selection = large_robot_planner_options();
+  selection.order = WaypointOrder::kSelection;
+  const WaypointPlan a = plan_waypoints(robot, kOffsets, start, tour);
+  const WaypointPlan b = plan_waypoints(robot, kOffsets, start, selection);
+  ASSERT_TRUE(a.ok()) << a.problem;
+  ASSERT_TRUE(b.ok()) << b.problem;
+  // THEN both visit the same waypoints; the selection order starts nearest
+  // the workspace's centre and travels longer than the tour
+  const auto positions = [](const WaypointPlan& plan) {
+    std::vector<std::array<double, 3>> out;
+    for (const Waypoint& w : plan.waypoints) {
+      const Eigen::Vector3d p = w.rest.world_T_platform.position_world;
+      out.push_back({p.x(), p.y(), p.z()});
+    }
+    return out;
+  };
+  std::vector<std::array<double, 3>> in_tour = positions(a), in_selection = positions(b);
+  EXPECT_NE(in_tour, in_selection);
+  std::sort(in_tour.begin(), in_tour.end());
+  std::sort(in_selection.begin(), in_selection.end());
+  EXPECT_EQ(in_tour, in_selection);
+  const auto travel = [&](const WaypointPlan& plan) {
+    std::vector<Pose> stops;
+    for (const Waypoint& w : plan.waypoints) stops.push_back(w.rest.world_T_platform);
+    std::vector<int> as_given(stops.size());
+    for (std::size_t k = 0; k < stops.size(); ++k) as_given[k] = static_cast<int>(k);
+    return tour_travel_m(robot, nominal_anchors(robot), Pose{start, Eigen::Quaterniond::Identity()}, stops, as_given);
+  };
+  EXPECT_LT(travel(a), 0.8 * travel(b));
 }
 
 TEST(WaypointPlanner, SameSeedSamePlan) {
