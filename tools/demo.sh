@@ -20,15 +20,12 @@
 set -euo pipefail
 build=$(cd "${1:-build}" && pwd)
 work=$(mktemp -d /tmp/cdpr-demo.XXXXXX)
-pids=()
+# shellcheck source=tools/processes.bash
+source "$(dirname "$0")/processes.bash"
 
 cleanup() {
   local status=$?
-  # Newest first: the daemon stops (winches halted) before the robot goes.
-  for (( k = ${#pids[@]} - 1; k >= 0; k-- )); do
-    kill -TERM "${pids[k]}" 2>/dev/null || true
-    wait "${pids[k]}" 2>/dev/null || true
-  done
+  stop_started
   if [[ $status -ne 0 ]]; then
     echo "demo failed; logs:" >&2
     tail -n 20 "$work"/*.log >&2 || true
@@ -38,16 +35,6 @@ cleanup() {
 }
 trap cleanup EXIT
 trap 'exit 130' INT TERM
-
-# Waits up to $2 seconds for file or socket $1.
-wait_for() {
-  for _ in $(seq 1 $(( $2 * 10 ))); do
-    [[ -e $1 ]] && return 0
-    sleep 0.1
-  done
-  echo "demo: $1 did not appear within $2 s" >&2
-  return 1
-}
 
 start=$(date +%s)
 echo "== virtual robot: large preset (240 x 220 x 50 m, 34 kg platform), physics 20x real time,"

@@ -24,15 +24,12 @@ mkdir -p "$out"
 out=$(cd "$out" && pwd)
 scale=${TIME_SCALE:-1}
 work=$(mktemp -d /tmp/cdpr-robot-time.XXXXXX)
-pids=()
+# shellcheck source=tools/processes.bash
+source "$(dirname "$0")/processes.bash"
 
 cleanup() {
   local status=$?
-  # Newest first: the daemon stops (winches halted) before the robot goes.
-  for (( k = ${#pids[@]} - 1; k >= 0; k-- )); do
-    kill -TERM "${pids[k]}" 2>/dev/null || true
-    wait "${pids[k]}" 2>/dev/null || true
-  done
+  stop_started
   cp -r "$work"/*.log "$work/state" "$work/cdpr-calibd.toml" "$out/" 2>/dev/null || true
   cp "$work/robot/truth.toml" "$work/robot/robot.toml" "$out/" 2>/dev/null || true
   rm -rf "$work"
@@ -40,15 +37,6 @@ cleanup() {
 }
 trap cleanup EXIT
 trap 'exit 130' INT TERM
-
-wait_for() {
-  for _ in $(seq 1 $(( $2 * 10 ))); do
-    [[ -e $1 ]] && return 0
-    sleep 0.1
-  done
-  echo "robot-time: $1 did not appear within $2 s" >&2
-  return 1
-}
 
 "$build/tools/virtual-robot/virtual-robot" --preset large --seed "${SEED:-7}" --time-scale "$scale" \
   --anchor-perturbation 0.3 --modbus-transport rtu --load-cell-model flintec-ft-11 \
