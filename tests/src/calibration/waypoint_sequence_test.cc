@@ -44,7 +44,7 @@ TEST(WaypointSequence, AFailedReSolveFallsBackToTheNextSpreadWaypoint) {
   }
   // THEN the run goes on to max_count, each waypoint after the initial set
   // the next unused one in spread order, and the remark says so
-  EXPECT_EQ(static_cast<int>(visited.size()), sequential.max_count);
+  EXPECT_EQ(static_cast<int>(visited.size()), sequential.max_count) << sequence.stop_reason();
   EXPECT_GE(fallbacks, 1);
 }
 
