@@ -116,13 +116,17 @@ SequentialPlanner::SequentialPlanner(const Robot& nominal, std::vector<Waypoint>
   const std::vector<int> order = tour_order(nominal_, nominal_anchors(nominal_), start, poses);
   for (const int k : order) initial_.push_back(spread_[k]);
   next_ = initial_.front();
-  Pose from = start;
+  estimate_initial_left();
+}
+
+void SequentialPlanner::estimate_initial_left() {
+  Pose from = at_;
   status_.estimated_time_left_s = 0.0;
-  for (const int k : initial_) {
-    status_.estimated_time_left_s += move_time_s(from, k);
-    from = candidates_[k].rest.world_T_platform;
+  for (std::size_t j = initial_done_; j < initial_.size(); ++j) {
+    status_.estimated_time_left_s += move_time_s(from, initial_[j]);
+    from = candidates_[initial_[j]].rest.world_T_platform;
   }
-  status_.estimated_samples_left = static_cast<int>(initial_.size());
+  status_.estimated_samples_left = static_cast<int>(initial_.size() - initial_done_);
 }
 
 double SequentialPlanner::move_time_s(const Pose& from, int index) const {
@@ -152,13 +156,7 @@ void SequentialPlanner::moved_on() {
   while (initial_done_ < initial_.size() && used_[initial_[initial_done_]]) ++initial_done_;
   if (initial_done_ < initial_.size()) {
     next_ = initial_[initial_done_];
-    Pose from = at_;
-    status_.estimated_time_left_s = 0.0;
-    for (std::size_t j = initial_done_; j < initial_.size(); ++j) {
-      status_.estimated_time_left_s += move_time_s(from, initial_[j]);
-      from = candidates_[initial_[j]].rest.world_T_platform;
-    }
-    status_.estimated_samples_left = static_cast<int>(initial_.size() - initial_done_);
+    estimate_initial_left();
     return;
   }
   if (resolved_samples_ != samples_.size()) resolve();

@@ -148,6 +148,8 @@ class SequentialPlanner {
   };
 
   void moved_on();
+  // The rest of the initial set's modelled time, in status_.
+  void estimate_initial_left();
   void resolve();
   void replan();
   void decide();
