@@ -426,9 +426,10 @@ void CalibrationStateMachine::log_run(hal::TimeUs now_us, const char* outcome) {
 
 void CalibrationStateMachine::update_progress() {
   // Waypoints dominate the run's duration; solve and commit take the rest.
+  // The sequential strategy counts against its forecast, not its maximum.
   constexpr double kWaypointsStart = 0.05;
   constexpr double kWaypointsSpan = 0.85;
-  const int count = std::max(status_.waypoint_count, 1);
+  const int count = std::max(waypoints_.expected_count(), 1);
   double phase = 0.0;
   switch (status_.state) {
     case CalibrationState::kPreflight: status_.progress = 0.02; return;

@@ -14,9 +14,10 @@
 //
 // Time left: the remaining waypoints' modelled time (move at the winch
 // speed plus the expected settle, as the sequential planner models it; for
-// the sequential strategy its estimate of the samples still needed from the
-// sigma trend; before its first re-solve, the rest of its initial set: a
-// lower bound) scaled by how the robot time spent so far compared with the
+// the sequential strategy its forecast of the waypoints still needed from
+// the expected information, discounted by the progress the re-solves have
+// shown; before its first re-solve, the rest of its initial set: a lower
+// bound) scaled by how the robot time spent so far compared with the
 // model. The run's own clock measures, so the estimate follows the robot
 // (or a virtual robot's time scale).
 // Pure logic: no I/O; times are passed in.
@@ -53,6 +54,9 @@ class WaypointSequence {
   int planned() const;
   // Waypoints sampled or skipped so far.
   int visited() const { return visited_; }
+  // Waypoints the run is expected to visit in all: the fixed plan's size,
+  // or those visited plus the sequential planner's forecast.
+  int expected_count() const;
   // Why the waypoints ended: "plan done", or the sequential planner's stop
   // reason ("target reached", "max count", "no candidates left").
   std::string stop_reason() const;
@@ -69,13 +73,13 @@ class WaypointSequence {
   double time_left_s() const { return time_left_s_; }
   hal::TimeUs estimated_at_us() const { return estimated_at_us_; }
 
-  // The fixed plan (travel order), or the candidates (sequential).
+  // The fixed plan (travel order), or the first candidates (sequential: the
+  // planner may plan them again from its estimate).
   const WaypointPlan& plan() const { return plan_; }
 
  private:
   // Bookkeeping after the current waypoint was sampled or skipped at `reached`.
   void visited(const Pose& reached, hal::TimeUs now_us);
-  void choose_next();
   double modelled_s(const Pose& from, const Pose& to) const;
   double modelled_left_s() const;
 
@@ -84,9 +88,6 @@ class WaypointSequence {
   SequentialOptions sequential_options_;
   WaypointPlan plan_;                          // fixed plan, or the candidates
   std::optional<SequentialPlanner> sequential_;
-  std::vector<int> spread_order_;              // sequential: the fallback order over the candidates
-  std::vector<bool> used_;                     // sequential: candidates sampled or skipped
-  std::optional<int> index_;                   // sequential: the current candidate
   int visited_ = 0;
   Pose start_pose_;
   Pose at_;                                    // where the platform was last sent

@@ -26,12 +26,12 @@ int run_replay(const cdpr::accuracy::ReplayCase& c, const std::string& preset_na
     if (verbose) {
       std::printf("seed %3llu %s time %6.1f min waypoints %2d skipped %d travel %7.1f m (nearest neighbour alone "
                   "%7.1f m) anchor mean %.4f worst %.4f m offset %.4f m largest sigma anchor %.4f offset %.4f m "
-                  "error/sigma RMS %.2f%s%s %s\n",
+                  "error/sigma RMS %.2f forecast of waypoints left: mean |error| %.1f, bias %+.1f%s%s %s\n",
                   static_cast<unsigned long long>(r.seed), r.ok ? "ok    " : "FAILED", r.robot_time_s / 60.0,
                   r.waypoints, r.skipped, r.travel_m, r.travel_nn_m, r.anchor_error_m, r.worst_anchor_error_m,
                   r.offset_error_m, r.largest_anchor_sigma_m, r.largest_offset_sigma_m,
                   r.normalised_count ? std::sqrt(r.normalised_sq_sum / r.normalised_count) : 0.0,
-                  r.stop.empty() ? "" : " stop: ",
+                  r.forecast_abs_error, r.forecast_bias, r.stop.empty() ? "" : " stop: ",
                   r.stop.c_str(), r.ok ? "" : r.message.c_str());
     } else {
       std::fprintf(stderr, "\r%s: run %d/%d", strategy.c_str(), s + 1, seeds);
@@ -137,6 +137,10 @@ int main(int argc, char** argv) {
                  "replay: a sample row's noise as a fraction of one reading's (the daemon averages a rest window of "
                  "about 100 readings)")
       ->check(CLI::PositiveNumber)->capture_default_str();
+  bool no_replan = false;
+  app.add_flag("--no-replan", no_replan,
+               "sequential: keep the candidates planned from the nominal anchors (the daemon plans them again from "
+               "its estimate)");
   std::vector<int> candidate_grid;
   app.add_option("--candidate-grid", candidate_grid,
                  "sequential: candidate grid xy,z (default: the daemon's [waypoints] grid_xy, grid_z)")
@@ -166,6 +170,7 @@ int main(int argc, char** argv) {
                            : strategy == "informative" ? cdpr::accuracy::Strategy::kInformative
                                                        : cdpr::accuracy::Strategy::kSequential;
     replay_case.count = poses;
+    replay_case.replan = !no_replan;
     if (candidate_grid.size() == 2) {
       replay_case.candidate_grid_xy = candidate_grid[0];
       replay_case.candidate_grid_z = candidate_grid[1];

@@ -135,10 +135,10 @@ ReplayResult replay(const ReplayCase& c, std::uint64_t seed) {
   Rig rig(*data, c, seed, start);
   std::vector<Sample> samples;
   if (c.strategy == Strategy::kSequential) {
+    calibration::PlannerOptions grid = options;
+    if (c.candidate_grid_xy > 0) grid.grid_xy = c.candidate_grid_xy;
+    if (c.candidate_grid_z > 0) grid.grid_z = c.candidate_grid_z;
     if (c.candidate_grid_xy > 0 || c.candidate_grid_z > 0) {
-      calibration::PlannerOptions grid = options;
-      if (c.candidate_grid_xy > 0) grid.grid_xy = c.candidate_grid_xy;
-      if (c.candidate_grid_z > 0) grid.grid_z = c.candidate_grid_z;
       candidates = calibration::candidate_waypoints(nominal, no_offsets, grid);
       if (!candidates.ok() || candidates.waypoints.empty()) {
         r.message = "no candidates: " + candidates.problem;
@@ -147,16 +147,26 @@ ReplayResult replay(const ReplayCase& c, std::uint64_t seed) {
     }
     calibration::SequentialOptions sequential = c.sequential;
     sequential.solver = CalibrationOptions{};
-    calibration::SequentialPlanner planner(nominal, std::move(candidates.waypoints), start, sequential);
+    std::optional<calibration::CandidateSource> source;
+    if (c.replan) source = calibration::CandidateSource{grid, no_offsets};
+    calibration::SequentialPlanner planner(nominal, std::move(candidates.waypoints), start, sequential, source);
+    std::vector<std::pair<int, int>> forecasts;  // (samples so far, forecast left) after each re-solve
     while (const std::optional<int> k = planner.next()) {
       if (std::optional<Sample> sample = rig.visit(*k, planner.candidates()[*k])) {
         planner.add_sample(*k, *sample);
+        const calibration::SequentialStatus status = planner.status();
+        if (status.solved && planner.next()) forecasts.emplace_back(status.samples, status.estimated_samples_left);
       } else {
         ++r.skipped;
         planner.skip(*k);
       }
     }
     samples = planner.samples();
+    for (const auto& [so_far, left] : forecasts) {
+      const double error = left - (static_cast<double>(samples.size()) - so_far);
+      r.forecast_abs_error += std::abs(error) / forecasts.size();
+      r.forecast_bias += error / forecasts.size();
+    }
     r.stop = calibration::to_string(planner.status().stop);
   } else {
     options.selection = c.strategy == Strategy::kInformative ? calibration::WaypointSelection::kInformative

@@ -46,6 +46,8 @@ struct ReplayCase {
   // Sequential: its candidate grid (0: the daemon's [waypoints] grid_xy, grid_z).
   int candidate_grid_xy = 0, candidate_grid_z = 0;
   calibration::SequentialOptions sequential;  // also the robot-time model (winch speed, settle)
+  // Sequential: plan the candidates again from the estimate, as the daemon does.
+  bool replan = true;
 };
 
 struct ReplayResult {
@@ -58,6 +60,10 @@ struct ReplayResult {
   int waypoints = 0;            // measured
   int skipped = 0;
   std::string stop;             // sequential: why it stopped
+  // Sequential: the planner's forecast of the waypoints still to sample,
+  // after each re-solve, against those it then sampled: mean |error| and
+  // mean error (forecast - actual) over the re-solves.
+  double forecast_abs_error = 0.0, forecast_bias = 0.0;
   double anchor_error_m = 0.0;        // mean over cables of |a - a_true|
   double worst_anchor_error_m = 0.0;  // largest over cables
   double offset_error_m = 0.0;        // mean over cables of |l0 - l0_true|
