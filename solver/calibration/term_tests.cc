@@ -25,7 +25,6 @@ constexpr double kIdentifiableShare = 1e-10;
 constexpr int kLocalDim = 8;                  // pose tangent (6) and reference force (2)
 constexpr int kBaseGlobalDim = 4 * kCableCount;  // anchor (3) and offset (1) per cable
 constexpr int kPriorRows = 6;
-constexpr int kRows = kPriorRows + EffectPoseFactor::kResidualDim;
 
 using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
@@ -86,9 +85,6 @@ struct ReducedSystem {
 bool reduce(const Robot& robot, const CalibrationOptions& options, const CalibrationResult& result,
             const Extension& x, ReducedSystem& out) {
   const int g = x.global_dim;
-  out.matrix = Eigen::MatrixXd::Zero(g, g);
-  out.gradient = Eigen::VectorXd::Zero(g);
-  out.own = Eigen::VectorXd::Zero(g);
 
   // Parameter blocks in EffectPoseFactor's keys() order.
   std::array<double, 7> pose{};
@@ -129,44 +125,60 @@ bool reduce(const Robot& robot, const CalibrationOptions& options, const Calibra
   double* prior_jacobians[] = {prior_block.data()};
 
   const Loss loss{options.huber_width};
-  Eigen::Matrix<double, kRows, kLocalDim> local;
-  Eigen::MatrixXd global(kRows, g);
-  Eigen::Matrix<double, kRows, 1> residual;
-  for (std::size_t k = 0; k < result.fitted_rows.size(); ++k) {
+  // Every pose's global rows and their eliminated part, stacked, so that
+  // S and b come from two products over all poses at the end.
+  constexpr int kFactorRows = EffectPoseFactor::kResidualDim;
+  const int n = static_cast<int>(result.fitted_rows.size());
+  Eigen::MatrixXd rows(n * kFactorRows, g), eliminated(n * kLocalDim, g);
+  Eigen::VectorXd row_residuals(n * kFactorRows), eliminated_residuals(n * kLocalDim);
+  Eigen::Matrix<double, kFactorRows, kLocalDim> local;
+  Eigen::Matrix<double, kPriorRows, 1> prior_residual;
+  for (int k = 0; k < n; ++k) {
     const FittedRow& row = result.fitted_rows[k];
-    const int index = static_cast<int>(k);
     const Eigen::Vector3d& p = row.world_T_platform.position_world;
     const Eigen::Quaterniond& q = row.world_T_platform.world_R_platform;
     pose = {p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z()};
     force = {row.reference_force(0), row.reference_force(1)};
     const SampleSigmas sigma = reading_sigmas(robot, row.sample);
-    const PosePriorFactor prior(index, {row.sample.position_world, row.sample.world_R_platform}, sigma.position_m,
+    const PosePriorFactor prior(k, {row.sample.position_world, row.sample.world_R_platform}, sigma.position_m,
                                 sigma.orientation_rad, loss);
-    const EffectPoseFactor factor(robot, index, row.sample, options.height_sigma_m, loss, x.effects);
+    const EffectPoseFactor factor(robot, k, row.sample, options.height_sigma_m, loss, x.effects);
     double cost = 0.0;
-    if (!prior.evaluate(parameters.data(), residual.data(), prior_jacobians, &cost)) return false;
-    if (!factor.evaluate(parameters.data(), residual.data() + kPriorRows, jacobians.data(), &cost)) return false;
-    if (!residual.allFinite()) return false;
-    local.setZero();
-    global.setZero();
-    local.topLeftCorner<kPriorRows, 6>() = Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(prior_block.data());
+    auto global = rows.middleRows(k * kFactorRows, kFactorRows);
+    auto residual = row_residuals.segment(k * kFactorRows, kFactorRows);
+    if (!prior.evaluate(parameters.data(), prior_residual.data(), prior_jacobians, &cost)) return false;
+    if (!factor.evaluate(parameters.data(), residual.data(), jacobians.data(), &cost)) return false;
     for (std::size_t b = 0; b < blocks.size(); ++b) {
-      const Eigen::Map<const RowMajor> block(blocks[b].data(), EffectPoseFactor::kResidualDim, block_dims[b]);
-      if (b < 2) local.block(kPriorRows, b == 0 ? 0 : 6, EffectPoseFactor::kResidualDim, block_dims[b]) = block;
-      else global.block(kPriorRows, block_column[b], EffectPoseFactor::kResidualDim, block_dims[b]) = block;
+      const Eigen::Map<const RowMajor> block(blocks[b].data(), kFactorRows, block_dims[b]);
+      if (b < 2) local.middleCols(b == 0 ? 0 : 6, block_dims[b]) = block;
+      else global.middleCols(block_column[b], block_dims[b]) = block;
     }
-    if (!local.allFinite() || !global.allFinite()) return false;
-    const Eigen::Matrix<double, kLocalDim, kLocalDim> a = local.transpose() * local;
+    if (!residual.allFinite() || !prior_residual.allFinite() || !local.allFinite() || !global.allFinite()) {
+      return false;
+    }
+    // The pose prior reaches the pose only.
+    const Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> prior_jacobian(prior_block.data());
+    Eigen::Matrix<double, kLocalDim, kLocalDim> a = local.transpose() * local;
+    a.topLeftCorner<6, 6>() += prior_jacobian.transpose() * prior_jacobian;
+    Eigen::Matrix<double, kLocalDim, 1> local_gradient = local.transpose() * residual;
+    local_gradient.head<6>() += prior_jacobian.transpose() * prior_residual;
     const Eigen::LLT<Eigen::Matrix<double, kLocalDim, kLocalDim>> a_factor(a);
     if (a_factor.info() != Eigen::Success) return false;
-    const Eigen::MatrixXd coupling = local.transpose() * global;           // B_k
-    const Eigen::MatrixXd eliminated = a_factor.matrixL().solve(coupling);  // L^-1 B_k
-    const Eigen::Matrix<double, kLocalDim, 1> local_gradient =
-        a_factor.matrixL().solve(local.transpose() * residual);
-    out.matrix.noalias() += global.transpose() * global - eliminated.transpose() * eliminated;
-    out.gradient.noalias() += global.transpose() * residual - eliminated.transpose() * local_gradient;
-    out.own += global.colwise().squaredNorm().transpose();
+    // With A = L L': B' A^-1 B = (L^-1 B)' (L^-1 B), B = J_l' J_g.
+    Eigen::Matrix<double, kLocalDim, kFactorRows> to_local = local.transpose();
+    a_factor.matrixL().solveInPlace(to_local);
+    a_factor.matrixL().solveInPlace(local_gradient);
+    eliminated.middleRows(k * kLocalDim, kLocalDim).noalias() = to_local.lazyProduct(global);
+    eliminated_residuals.segment<kLocalDim>(k * kLocalDim) = local_gradient;
   }
+  // Symmetric: the lower triangles alone, then mirrored.
+  out.matrix = Eigen::MatrixXd::Zero(g, g);
+  out.matrix.selfadjointView<Eigen::Lower>().rankUpdate(rows.transpose(), 1.0);
+  out.matrix.selfadjointView<Eigen::Lower>().rankUpdate(eliminated.transpose(), -1.0);
+  out.matrix.triangularView<Eigen::StrictlyUpper>() = out.matrix.transpose();
+  out.gradient.noalias() = rows.transpose() * row_residuals;
+  out.gradient.noalias() -= eliminated.transpose() * eliminated_residuals;
+  out.own = rows.colwise().squaredNorm().transpose();
   return true;
 }
 
