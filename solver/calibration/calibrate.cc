@@ -10,6 +10,7 @@
 #include "solver/calibration/model_fit_check.h"
 #include "solver/calibration/single_fit.h"
 #include "solver/calibration/start_selection.h"
+#include "solver/calibration/term_tests.h"
 
 namespace cdpr {
 
@@ -403,10 +404,14 @@ CalibrationResult best_of_starts(const Robot& robot, const std::vector<Sample>& 
 }  // namespace
 
 CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& samples, const CalibrationOptions& options) {
-  CalibrationResult first = calibrate_from(robot, samples, options);
-  if (!options.robust || options.cable_model != CableModelKind::kCatenary || !worth_other_starts(first)) return first;
-  // The set the kept fit left out gets its swap test once, at the end.
-  return swap_within_rows(robot, samples, options, best_of_starts(robot, samples, options, std::move(first)));
+  CalibrationResult result = calibrate_from(robot, samples, options);
+  if (options.robust && options.cable_model == CableModelKind::kCatenary && worth_other_starts(result)) {
+    // The set the kept fit left out gets its swap test once, at the end.
+    result = swap_within_rows(robot, samples, options, best_of_starts(robot, samples, options, std::move(result)));
+  }
+  // Once, on the fit kept: the choice among fits above is by the chi-square test alone.
+  test_missing_terms(robot, options, result);
+  return result;
 }
 
 }  // namespace cdpr

@@ -13,6 +13,7 @@
 #include "solver/model/effects.h"
 #include "solver/nls/levenberg_marquardt.h"
 #include "solver/nls/loss.h"
+#include "solver/nls/pose.h"
 #include "solver/nls/problem.h"
 #include "solver/model/robot.h"
 #include "solver/model/sample.h"
@@ -44,6 +45,12 @@ struct CalibrationOptions {
   // freedom; a model that does not fit at this significance is reported in
   // Calibration::model_warning and its sigmas are scaled up by the misfit.
   double misfit_alpha = 1e-3;
+  // The tests of the known model terms the fit does not have
+  // (solver/calibration/term_tests.h): one score test per term at the final
+  // fit, this level shared among them (Bonferroni). A term asked for is a
+  // misfit as the chi-square test's is. <= 0, or misfit_alpha <= 0 (no
+  // model-fit check at all): not run.
+  double term_test_alpha = 1e-6;
   // Well-determined fits take 10-60; a few with sparse data (8 poses on the
   // small robot) crawl along a flat valley for 250-450 before converging,
   // and stopping them at 200 left them up to 0.3 m short even on noiseless data.
@@ -64,6 +71,27 @@ struct FittedEffect {
   Effect effect = Effect::kElasticity;
   std::vector<double> value;
   std::vector<double> sigma;  // 1-sigma from the covariance
+};
+
+// The score test of one model term the final fit does not have
+// (solver/calibration/term_tests.h).
+struct TermTest {
+  Effect effect = Effect::kElasticity;
+  // False when its columns are (nearly) in the span of the fitted unknowns'
+  // on these poses: the data cannot tell it apart, so it is not tested.
+  bool identifiable = true;
+  double statistic = 0.0;  // score statistic, ~ chi-square(dof) when the fitted model holds
+  int dof = 0;             // directions of the term the data can see
+  double p = 1.0;          // upper-tail probability of statistic
+  bool asked_for = false;  // p below the per-term level
+};
+
+// One pose of the final fit as it ended: the row as fitted (gross errors
+// masked), its platform pose and the reference cable's force (f_h, f_v).
+struct FittedRow {
+  Sample sample;
+  Pose world_T_platform;
+  Eigen::Vector2d reference_force = Eigen::Vector2d::Zero();
 };
 
 struct CalibrationResult {
@@ -87,6 +115,12 @@ struct CalibrationResult {
   int degrees_of_freedom = 0;
   double misfit_probability = 1.0;
   bool misfit = false;
+  // The tests of the terms the model lacks, in kAllEffects order (when ok,
+  // catenary and the model-fit check on); per-term level in term_test_level.
+  std::vector<TermTest> term_tests;
+  double term_test_level = 0.0;
+  // The final catenary fit's rows, for the tests that follow it (when ok).
+  std::vector<FittedRow> fitted_rows;
   std::vector<FittedEffect> effects;  // in CalibrationOptions::effects order, when ok
   // Covariance (tangent) of the global variables, in global_keys order:
   // AnchorKey(i), OffsetKey(i) per cable, then each effect's EffectKey.
@@ -126,7 +160,8 @@ std::vector<Sample> leave_out(const std::vector<Sample>& samples, const std::vec
 // the best fit kept (solver/calibration/start_selection.h), and on small
 // sets the readings left out are checked against their row's and cable's
 // other readings (docs/robust-calibration.md). Refuses (ok = false) when
-// more than max_rejected_fraction of the rows have gross errors.
+// more than max_rejected_fraction of the rows have gross errors. The kept
+// fit's missing model terms are tested last (term_tests).
 CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& samples,
                             const CalibrationOptions& options);
 

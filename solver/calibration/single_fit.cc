@@ -329,7 +329,14 @@ CalibrationResult calibrate_once(const Robot& robot, const std::vector<Sample>& 
   cal.fit.cost_final = result.solver.final_cost;
   cal.fit.iterations = result.solver.iterations;
   fill_fit_rms(robot, samples, problem, options, cal.fit);
-  if (catenary) result.left_out_residuals = left_out_residuals(robot, built, options);
+  if (catenary) {
+    result.left_out_residuals = left_out_residuals(robot, built, options);
+    result.fitted_rows.reserve(samples.size());
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+      const int pose = static_cast<int>(k);
+      result.fitted_rows.push_back({samples[k], problem.pose(PoseKey(pose)), problem.vector(ReferenceForceKey(pose))});
+    }
+  }
   result.chi_square = 2.0 * result.solver.final_cost;
   result.degrees_of_freedom = degrees_of_freedom(problem, samples);
   result.ok = covariance.size() > 0;

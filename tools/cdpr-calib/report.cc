@@ -38,7 +38,24 @@ void print_summary(std::FILE* out, const CalibrationResult& result, const Robot&
                  w.offset_m, w.offset_sigma_m);
   }
   print_effects(out, cal.effects);
+  print_term_tests(out, result);
   if (!cal.model_warning.empty()) std::fprintf(out, "MODEL WARNING: %s\n", cal.model_warning.c_str());
+}
+
+void print_term_tests(std::FILE* out, const CalibrationResult& result) {
+  if (result.term_tests.empty()) return;
+  std::fprintf(out, "terms not in the model (score test at the fit; level %.1e each):", result.term_test_level);
+  bool asked = false;
+  for (const TermTest& t : result.term_tests) {
+    std::fprintf(out, " %s", std::string(effect_model_name(t.effect)).c_str());
+    if (!t.identifiable) {
+      std::fprintf(out, " not identifiable;");
+      continue;
+    }
+    std::fprintf(out, " %.1f/%d p %.1e%s;", t.statistic, t.dof, t.p, t.asked_for ? " ASKED FOR" : "");
+    asked = asked || t.asked_for;
+  }
+  std::fprintf(out, " %s\n", asked ? "the model lacks a term" : "none asked for");
 }
 
 void print_gross_errors(std::FILE* out, const std::vector<SensorReading>& rejected) {

@@ -17,6 +17,9 @@ void print_effects(std::FILE* out, const EffectValues& effects);
 // it cannot compare are named as not compared, never refused.
 void print_truth_comparison(std::FILE* out, const Calibration& calibration, const Truth& truth);
 // Readings rejected as gross errors: row, sensor, cable, residual in sigmas.
+// One line: each model term the fit lacks, its score statistic / degrees of
+// freedom and p, or that it is not identifiable (solver/calibration/term_tests.h).
+void print_term_tests(std::FILE* out, const CalibrationResult& result);
 void print_gross_errors(std::FILE* out, const std::vector<SensorReading>& rejected);
 // Each planted gross error of truth.toml and whether it was rejected.
 void print_outlier_recall(std::FILE* out, const std::vector<SensorReading>& rejected,
