@@ -5,7 +5,8 @@
 # Appends "user sys wall output" per translation unit to $TIME_COMPILE_LOG
 # (default /tmp/time-compile.txt). Needs /usr/bin/time (Debian: time).
 # CPU seconds per target, highest first:
-#   awk '{split($4, p, "/"); s[p[2]] += $1 + $2} END {for (t in s) print s[t], t}' /tmp/tu.txt | sort -gr
+#   awk '{n = split($4, p, "/"); for (i = 1; i <= n; i++) if (p[i] ~ /[.]dir$/) t = p[i];
+#        s[t] += $1 + $2} END {for (t in s) print s[t], t}' /tmp/tu.txt | sort -gr
 # Anything after the launcher (e.g. ccache) runs as the compiler.
 out=""
 prev=""
