@@ -41,6 +41,45 @@ TEST(RobotPhysics, PlatformSettlesIntoTheEquilibriumOfTheCommandedPayouts) {
   EXPECT_NEAR(physics->tension_n(0), expected->cables[0].tension_n, 1e-3);
 }
 
+TEST(RobotPhysics, HeavyCablePaidOutPastItsRestLengthHangsInALoopThatStillPulls) {
+  // GIVEN the large robot at rest in the half of its workspace that cables 1-3 alone can hold
+  sim::TrueRobot robot = sim::preset_spec(sim::Preset::kLarge).robot;
+  robot.encoder_offset_m = {1.0, -2.0, 0.5, 3.0};
+  const Eigen::Vector3d start(150.0, 140.0, 17.0);
+  auto physics = RobotPhysics::at_rest(robot, start, PhysicsOptions{});
+  ASSERT_TRUE(physics) << physics.error();
+  const double p0 = physics->payout_m(0);
+  const double t0 = physics->tension_n(0);
+  // WHEN cable 0 is paid out 30 m and the sway has died out
+  physics->set_target(0, p0 + 30.0);
+  for (int k = 0; k < 2000; ++k) physics->advance(0.01);
+  for (int k = 0; k < 1000; ++k) physics->advance(1.0);
+  // THEN it is not slack: its deep loop pulls with part of its own weight, far less than before
+  EXPECT_EQ(physics->failed_solves(), 0);
+  EXPECT_FALSE(physics->rest().cables[0].slack);
+  EXPECT_GT(physics->tension_n(0), 20.0);
+  EXPECT_LT(physics->tension_n(0), 0.5 * t0);
+  // AND the platform rests near, not at, where the other three would hold it alone
+  std::array<double, kCableCount> unstretched{};
+  for (int i = 0; i < kCableCount; ++i) unstretched[i] = physics->payout_m(i) - robot.encoder_offset_m[i];
+  sim::SolverOptions options;
+  options.segments = PhysicsOptions{}.segments;
+  const auto three = sim::solve_forward_equilibrium(robot, unstretched, physics->pose(), options, {true});
+  ASSERT_TRUE(three) << three.error().message;
+  EXPECT_EQ(three->cables[0].tension_n, 0.0);
+  const double apart_m = (physics->pose().position_world - three->world_T_platform.position_world).norm();
+  EXPECT_GT(apart_m, 0.01);
+  EXPECT_LT(apart_m, 1.0);
+  // WHEN cable 0 is hauled back in
+  physics->set_target(0, p0);
+  for (int k = 0; k < 2000; ++k) physics->advance(0.01);
+  for (int k = 0; k < 1000; ++k) physics->advance(1.0);
+  // THEN the platform is back at the start with the tension it had
+  EXPECT_EQ(physics->failed_solves(), 0);
+  EXPECT_NEAR(physics->tension_n(0), t0, 1e-3);
+  EXPECT_LT((physics->pose().position_world - start).norm(), 1e-6);
+}
+
 TEST(RobotPhysics, PlatformSwaysAfterAMoveWithTheGeometricPeriodAndLightDamping) {
   // GIVEN the large robot at rest in the middle of its workspace
   const sim::TrueRobot robot = sim::preset_spec(sim::Preset::kLarge).robot;

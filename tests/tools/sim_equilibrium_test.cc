@@ -172,6 +172,60 @@ TEST(SimEquilibrium, ElasticityStretchesCablesUnderTension) {
   }
 }
 
+// Inside the triangle of anchors 1, 2, 3 (the large robot's far half):
+// those three cables can hold the platform there without cable 0.
+const Eigen::Vector3d kFarHalf(150.0, 140.0, 17.0);
+
+TEST(SimEquilibrium, SlackCableCarriesNothingAndThePlatformHangsOnTheOtherThree) {
+  // GIVEN the payouts of a taut rest pose, cable 0 paid out 30 m beyond it
+  const TrueRobot robot = robot_with(Preset::kLarge, {});
+  const Eigen::Vector3d position = kFarHalf;
+  const EquilibriumResult taut = solve_equilibrium(robot, position, 0.0);
+  ASSERT_TRUE(taut) << taut.error().message;
+  std::array<double, kCableCount> payout{};
+  for (int i = 0; i < kCableCount; ++i) payout[i] = taut->cables[i].payout_m;
+  payout[0] += 30.0;
+  // WHEN the platform settles with cable 0 slack
+  const EquilibriumResult slack =
+      solve_forward_equilibrium(robot, payout, taut->world_T_platform, SolverOptions{}, SlackCables{true});
+  ASSERT_TRUE(slack) << slack.error().message;
+  // THEN cable 0 carries nothing and hangs no shorter than its chord
+  const CableEquilibrium& c0 = slack->cables[0];
+  EXPECT_TRUE(c0.slack);
+  EXPECT_EQ(c0.tension_n, 0.0);
+  EXPECT_EQ(c0.payout_m, payout[0]);
+  EXPECT_LE((robot.robot.winches[0].anchor_world - c0.attachment_world).norm(), payout[0]);
+  // AND the other three hold the platform alone: forces and moments balance, their lengths are the commanded ones
+  Eigen::Vector3d force, moment;
+  net_wrench(robot, *slack, force, moment);
+  EXPECT_LT(force.norm(), 1e-6);
+  EXPECT_LT(moment.norm(), 1e-6);
+  for (int i = 1; i < kCableCount; ++i) {
+    EXPECT_FALSE(slack->cables[i].slack);
+    EXPECT_GT(slack->cables[i].tension_n, 0.0);
+    EXPECT_NEAR(slack->cables[i].payout_m, payout[i], 1e-9);
+  }
+  // AND the platform moved away from cable 0's anchor
+  EXPECT_GT((slack->world_T_platform.position_world - robot.robot.winches[0].anchor_world).norm(),
+            (position - robot.robot.winches[0].anchor_world).norm() + 0.1);
+}
+
+TEST(SimEquilibrium, CableShorterThanItsChordCannotHangSlack) {
+  // GIVEN the payouts of a taut rest pose, cable 0 hauled in by 1 m
+  const TrueRobot robot = robot_with(Preset::kLarge, {});
+  const EquilibriumResult taut = solve_equilibrium(robot, kFarHalf, 0.0);
+  ASSERT_TRUE(taut) << taut.error().message;
+  std::array<double, kCableCount> payout{};
+  for (int i = 0; i < kCableCount; ++i) payout[i] = taut->cables[i].payout_m;
+  payout[0] -= 1.0;
+  // WHEN the rest pose with cable 0 slack is asked for
+  const EquilibriumResult slack =
+      solve_forward_equilibrium(robot, payout, taut->world_T_platform, SolverOptions{}, SlackCables{true});
+  // THEN there is none: the other three would pull cable 0 taut
+  ASSERT_FALSE(slack);
+  EXPECT_EQ(slack.error().code, EquilibriumError::kSlackCable) << slack.error().message;
+}
+
 TEST(SimEquilibrium, InfeasiblePoseIsAnErrorValue) {
   // GIVEN a pose outside the anchors' footprint, where a cable would have to push
   const TrueRobot robot = robot_with(Preset::kLarge, {});

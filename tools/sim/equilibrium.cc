@@ -34,11 +34,13 @@ Unknowns inverse_unknowns() {
   return u;
 }
 
-Unknowns forward_unknowns() {
+Unknowns forward_unknowns(const SlackCables& slack) {
   Unknowns u;
   u.all = {0, 1, 2, si::kRoll, si::kPitch, si::kYaw};
   for (int i = 0; i < kCableCount; ++i) {
-    for (int j : {si::h(i), si::v(i), si::free_length(i)}) u.all.push_back(j);
+    if (!slack[i]) {
+      for (int j : {si::h(i), si::v(i), si::free_length(i)}) u.all.push_back(j);
+    }
     u.per_cable[i] = {si::h(i), si::v(i), si::free_length(i)};
   }
   return u;
@@ -97,12 +99,21 @@ EquilibriumResult newton(EquilibriumModel& model, State x, const Unknowns& unkno
                                 " iterations, |e| = " + std::to_string(e.norm()))};
 }
 
-// Every cable pulls, and the platform hangs upright.
-EquilibriumResult check_plausible(EquilibriumResult result) {
+// Every taut cable pulls, every slack one is no shorter than its chord, and
+// the platform hangs upright.
+EquilibriumResult check_plausible(const TrueRobot& robot, EquilibriumResult result) {
   if (!result) return result;
   const Equilibrium& eq = *result;
   for (int i = 0; i < kCableCount; ++i) {
-    if (!(eq.cables[i].h_n > 0.0 && eq.cables[i].tension_n > 0.0)) {
+    const CableEquilibrium& c = eq.cables[i];
+    if (c.slack) {
+      if ((robot.robot.winches[i].anchor_world - c.attachment_world).norm() > c.payout_m) {
+        return Unexpected{failure(EquilibriumError::kSlackCable,
+                                  "cable " + std::to_string(i) + " is shorter than its chord: it would be taut")};
+      }
+      continue;
+    }
+    if (!(c.h_n > 0.0 && c.tension_n > 0.0)) {
       return Unexpected{failure(EquilibriumError::kSlackCable, "cable " + std::to_string(i) + " is slack")};
     }
   }
@@ -120,12 +131,27 @@ EquilibriumResult solve_equilibrium(const TrueRobot& robot, const Eigen::Vector3
   EquilibriumModel model(robot, options.segments);
   const auto start = initial_state(model, position_world, yaw_rad, 0.1 * options.tolerance);
   if (!start) return Unexpected{start.error()};
-  return check_plausible(newton(model, *start, inverse_unknowns(), options));
+  return check_plausible(robot, newton(model, *start, inverse_unknowns(), options));
 }
 
 EquilibriumResult solve_forward_equilibrium(const TrueRobot& robot, const std::array<double, kCableCount>& payout_m,
-                                            const Pose& initial, const SolverOptions& options) {
+                                            const Pose& initial, const SolverOptions& options,
+                                            const SlackCables& slack) {
   const Eigen::Vector3d rpy = rpy_from_rotation(initial.world_R_platform.toRotationMatrix());
+  if (slack != SlackCables{}) {
+    // No inverse problem to start from: at a given position three cables
+    // cannot balance force and moment at once.
+    EquilibriumModel model(robot, options.segments);
+    model.set_slack(slack);
+    auto start = initial_state(model, initial.position_world, rpy.z(), 0.1 * options.tolerance);
+    if (!start) return Unexpected{start.error()};
+    State& x = *start;
+    for (int i = 0; i < kCableCount; ++i) {
+      x(si::free_length(i)) += payout_m[i] - x(si::payout(i));
+      x(si::payout(i)) = payout_m[i];
+    }
+    return check_plausible(robot, newton(model, x, forward_unknowns(slack), options));
+  }
   const EquilibriumResult at_initial = solve_equilibrium(robot, initial.position_world, rpy.z(), options);
   if (!at_initial) return at_initial;
 
@@ -143,7 +169,7 @@ EquilibriumResult solve_forward_equilibrium(const TrueRobot& robot, const std::a
     x(si::payout(i)) = payout_m[i];
   }
   EquilibriumModel model(robot, options.segments);
-  return check_plausible(newton(model, x, forward_unknowns(), options));
+  return check_plausible(robot, newton(model, x, forward_unknowns(slack), options));
 }
 
 const char* to_string(EquilibriumError error) {

@@ -41,8 +41,13 @@ EquilibriumResult solve_equilibrium(const TrueRobot& robot, const Eigen::Vector3
 // equilibrium at `initial` (position and yaw; its roll and pitch are ignored).
 // An underconstrained robot may have several equilibria: this returns the one
 // Newton reaches from `initial`.
+// With `slack` cables the platform hangs on the others alone: the slack
+// ones carry no force and must be at least as long as their chords in the
+// result (else kSlackCable: that cable would be taut). Newton then starts
+// from the rigid-cable force balance of the taut cables at `initial`.
 EquilibriumResult solve_forward_equilibrium(const TrueRobot& robot, const std::array<double, kCableCount>& payout_m,
-                                            const Pose& initial, const SolverOptions& options = {});
+                                            const Pose& initial, const SolverOptions& options = {},
+                                            const SlackCables& slack = {});
 
 const char* to_string(EquilibriumError error);
 

@@ -74,6 +74,7 @@ bool EquilibriumModel::in_domain(const State& x) const {
 }
 
 bool EquilibriumModel::cable_in_domain(const State& x, int i) const {
+  if (slack_[i]) return x.segment<6>(0).allFinite();
   if (!(x(si::h(i)) > 0.0 && x(si::free_length(i)) > 0.0 && x(si::payout(i)) > 0.0)) return false;
   if (!x.segment<6>(0).allFinite() || !std::isfinite(x(si::v(i)))) return false;
   const Eigen::Matrix3d R = rotation_from_rpy(x(si::kRoll), x(si::kPitch), x(si::kYaw));
@@ -84,7 +85,8 @@ bool EquilibriumModel::cable_in_domain(const State& x, int i) const {
 
 Equations EquilibriumModel::evaluate(const State& x) {
   for (int i = 0; i < kCableCount; ++i) {
-    shots_[i] = shoot_cable(cable_, x(si::h(i)), x(si::v(i)), x(si::free_length(i)), segments_);
+    shots_[i] = slack_[i] ? CableShot{}
+                          : shoot_cable(cable_, x(si::h(i)), x(si::v(i)), x(si::free_length(i)), segments_);
   }
   return geometry(x);
 }
@@ -108,6 +110,10 @@ Equations EquilibriumModel::geometry(const State& x) const {
 
   Equations e;
   for (int i = 0; i < kCableCount; ++i) {
+    if (slack_[i]) {
+      e.segment<3>(6 + 3 * i).setZero();
+      continue;
+    }
     const CableTerms c = cable_terms(robot_, x, R, i);
     force += c.force_n;
     moment += c.lever_world.cross(c.force_n);
@@ -119,6 +125,7 @@ Equations EquilibriumModel::geometry(const State& x) const {
 }
 
 bool EquilibriumModel::project_cable(State& x, int i, const std::array<int, 3>& unknowns, double tolerance) {
+  if (slack_[i]) return true;
   const Eigen::Matrix3d R = rotation_from_rpy(x(si::kRoll), x(si::kPitch), x(si::kYaw));
   auto shoot = [&] { shots_[i] = shoot_cable(cable_, x(si::h(i)), x(si::v(i)), x(si::free_length(i)), segments_); };
   if (!cable_in_domain(x, i)) return false;
@@ -188,8 +195,14 @@ Equilibrium EquilibriumModel::describe(const State& x) const {
   eq.pitch_rad = x(si::kPitch);
   eq.yaw_rad = x(si::kYaw);
   for (int i = 0; i < kCableCount; ++i) {
-    const CableTerms c = cable_terms(robot_, x, R, i);
     CableEquilibrium& out = eq.cables[i];
+    if (slack_[i]) {
+      out.attachment_world = x.segment<3>(si::kPosition) + R * robot_.robot.winches[i].attachment_platform;
+      out.payout_m = out.free_unstretched_m = out.free_arc_m = out.arc_length_m = x(si::payout(i));
+      out.slack = true;
+      continue;
+    }
+    const CableTerms c = cable_terms(robot_, x, R, i);
     out.attachment_world = c.attachment_world;
     out.h_n = x(si::h(i));
     out.v_n = x(si::v(i));

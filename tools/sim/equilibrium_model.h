@@ -17,6 +17,8 @@
 //        payout - free length - unstretched wrapped arc [m].
 // 22 unknowns and 18 equations: the inverse problem frees roll, pitch and the
 // cable unknowns; the forward problem frees the pose, forces and free lengths.
+// A slack cable (set_slack) adds no force and its three rows are 0: the
+// forward problem then frees the pose and the taut cables' unknowns only.
 
 #include <array>
 #include <vector>
@@ -54,7 +56,11 @@ class EquilibriumModel {
   // Keeps a reference to `robot`, which must outlive the model.
   EquilibriumModel(const TrueRobot& robot, int segments);
 
-  // Forces positive, lengths positive, no cable vertical.
+  // Cables that hang slack (none by default).
+  void set_slack(const SlackCables& slack) { slack_ = slack; }
+  bool slack(int cable) const { return slack_[cable]; }
+
+  // Forces positive, lengths positive, no cable vertical (taut cables).
   bool in_domain(const State& x) const;
   bool cable_in_domain(const State& x, int cable) const;
   // Shoots every cable (the costly part), keeps the shots for jacobian() and
@@ -84,6 +90,7 @@ class EquilibriumModel {
   int segments_;
   CableProperties cable_;
   std::array<CableShot, kCableCount> shots_;
+  SlackCables slack_{};
 };
 
 }  // namespace cdpr::sim

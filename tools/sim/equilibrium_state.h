@@ -12,6 +12,10 @@
 
 namespace cdpr::sim {
 
+// Which cables hang slack: a slack cable carries no force (its own weight
+// on the platform is neglected) and is at least as long as its chord.
+using SlackCables = std::array<bool, kCableCount>;
+
 struct CableEquilibrium {
   Eigen::Vector3d attachment_world = Eigen::Vector3d::Zero();  // [m]
   double h_n = 0.0;        // [N] horizontal force on the platform, towards the anchor (> 0)
@@ -25,6 +29,7 @@ struct CableEquilibrium {
   double free_arc_m = 0.0;     // [m] true (stretched) length of the free cable
   double wrapped_arc_m = 0.0;  // [m] geometric cable length on the pulley (0 without pulley)
   double arc_length_m = 0.0;   // [m] free_arc + wrapped_arc: true cable length from A to the attachment
+  bool slack = false;          // no tension: h, v, tension 0, the lengths all payout_m
 };
 
 struct Equilibrium {

@@ -4,6 +4,7 @@
 #include <string>
 
 #include <Eigen/LU>
+#include <Eigen/QR>
 
 namespace cdpr::sim {
 namespace {
@@ -31,6 +32,7 @@ Expected<State, EquilibriumFailure> initial_state(EquilibriumModel& model, const
   const Eigen::Vector3d external = robot.effects.wind_force_world_n - robot.platform_weight_n() * Eigen::Vector3d::UnitZ();
   Eigen::Vector4d load;
   load << -external, -(R * robot.center_of_mass_platform()).cross(external).z();
+  bool any_slack = false;
   for (int i = 0; i < kCableCount; ++i) {
     const Eigen::Vector3d lever = R * robot.robot.winches[i].attachment_platform;
     attachment[i] = position_world + lever;
@@ -40,14 +42,21 @@ Expected<State, EquilibriumFailure> initial_state(EquilibriumModel& model, const
                                 "cable " + std::to_string(i) + " hangs straight below its anchor")};
     }
     chord[i] = d.norm();
+    if (model.slack(i)) {
+      statics.col(i).setZero();
+      any_slack = true;
+      continue;
+    }
     const Eigen::Vector3d direction = d / chord[i];
     statics.col(i) << direction, lever.cross(direction).z();
     load.z() += 0.5 * w * chord[i];
   }
-  Eigen::Vector4d tension = statics.fullPivLu().solve(load);
-  if (!tension.allFinite() || !(statics * tension).isApprox(load, 1e-9)) {
+  // Fewer than four taut cables: the force balance alone (the yaw moment is Newton's).
+  const Eigen::Matrix<double, 3, kCableCount> forces = statics.topRows<3>();
+  Eigen::Vector4d tension = any_slack ? Eigen::Vector4d(forces.colPivHouseholderQr().solve(load.head<3>()))
+                                      : Eigen::Vector4d(statics.fullPivLu().solve(load));
+  if (!any_slack && (!tension.allFinite() || !(statics * tension).isApprox(load, 1e-9))) {
     // Degenerate heading: fall back to the min-norm force balance.
-    const Eigen::Matrix<double, 3, kCableCount> forces = statics.topRows<3>();
     tension = forces.transpose() * (forces * forces.transpose()).inverse() * load.head<3>();
   }
 
@@ -55,6 +64,11 @@ Expected<State, EquilibriumFailure> initial_state(EquilibriumModel& model, const
   x.segment<3>(si::kPosition) = position_world;
   x(si::kYaw) = yaw_rad;
   for (int i = 0; i < kCableCount; ++i) {
+    if (model.slack(i)) {
+      x(si::free_length(i)) = chord[i];
+      x(si::payout(i)) = chord[i];
+      continue;
+    }
     if (!(tension(i) > 0.0)) {
       return Unexpected{failure(EquilibriumError::kInfeasible,
                                 "rigid statics need cable " + std::to_string(i) + " to push at this pose")};

@@ -1,7 +1,10 @@
 #pragma once
 // A starting point for the equilibrium Newton (sim/equilibrium.h) at a given
 // position and yaw, with the platform level: rigid-cable statics give the
-// tensions, then each cable alone is shot onto its pulley.
+// tensions, then each cable alone is shot onto its pulley. The model's slack
+// cables (EquilibriumModel::set_slack) take no part: the taut ones balance
+// the platform's weight alone (force balance only), and a slack cable's
+// state is h = v = 0 with its free length and payout the chord.
 
 #include <Eigen/Core>
 

@@ -93,6 +93,7 @@ int main(int argc, char** argv) {
               (*robot)->modbus_endpoint().c_str(), (*robot)->pose_endpoint().c_str());
   std::fflush(stdout);
   (*robot)->run(g_stop);
-  std::printf("virtual-robot: stopped (%d equilibrium solves failed)\n", (*robot)->physics().failed_solves());
+  std::printf("virtual-robot: stopped (%d equilibrium solves failed, %d with a slack cable)\n",
+              (*robot)->physics().failed_solves(), (*robot)->physics().slack_solves());
   return 0;
 }

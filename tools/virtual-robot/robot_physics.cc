@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 
 namespace cdpr::virtual_robot {
 namespace {
@@ -27,39 +28,63 @@ void sway_step(double omega, double zeta, double dt, Deviation& e, Deviation& v)
 // between its pulley and the attachment at the initial pose, which needs
 // every cable longer than its chord there; this gives such a start close to
 // the solution, even after a long move or with one cable much too long.
-// Falls back to `pose` when no three chords meet.
-Pose hanging_chord_pose(const sim::TrueRobot& robot, const std::array<double, kCableCount>& length_m, double shrink,
-                        const Pose& pose) {
+// The pose, orientation kept, at which the chords of all cables but
+// `skipped` are exactly (1 - shrink) times their lengths and that of
+// `skipped` is not longer (that cable sags more, or hangs slack); none when
+// no such pose is found.
+std::optional<Pose> three_chord_pose(const sim::TrueRobot& robot, const std::array<double, kCableCount>& length_m,
+                                     double shrink, const Pose& pose, int skipped) {
   const auto chord = [&](const Pose& p, int i) {
     return (p.transform(robot.robot.winches[i].attachment_platform) - robot.robot.winches[i].anchor_world).eval();
   };
+  Pose p = pose;
+  p.position_world.z() -= 5.0;  // start below: Newton then finds the lower (hanging) intersection
+  bool converged = false;
+  for (int iteration = 0; iteration < 30 && !converged; ++iteration) {
+    Eigen::Matrix3d jacobian;
+    Eigen::Vector3d residual;
+    for (int row = 0, i = 0; i < kCableCount; ++i) {
+      if (i == skipped) continue;
+      const Eigen::Vector3d c = chord(p, i);
+      residual(row) = c.norm() - (1.0 - shrink) * length_m[i];
+      jacobian.row(row++) = c.normalized().transpose();
+    }
+    const Eigen::Vector3d step = jacobian.fullPivLu().solve(-residual);
+    if (!step.allFinite()) break;
+    p.position_world += step;
+    converged = step.norm() < 1e-9;
+  }
+  if (!converged || chord(p, skipped).norm() > (1.0 - shrink) * length_m[skipped]) return std::nullopt;
+  return p;
+}
+
+// The lowest three_chord_pose() over the skipped cable; falls back to
+// `pose` when no three chords meet.
+Pose hanging_chord_pose(const sim::TrueRobot& robot, const std::array<double, kCableCount>& length_m, double shrink,
+                        const Pose& pose) {
   Pose best = pose;
   double best_z = std::numeric_limits<double>::infinity();
   for (int skipped = 0; skipped < kCableCount; ++skipped) {
-    Pose p = pose;
-    p.position_world.z() -= 5.0;  // start below: Newton then finds the lower (hanging) intersection
-    bool converged = false;
-    for (int iteration = 0; iteration < 30 && !converged; ++iteration) {
-      Eigen::Matrix3d jacobian;
-      Eigen::Vector3d residual;
-      for (int row = 0, i = 0; i < kCableCount; ++i) {
-        if (i == skipped) continue;
-        const Eigen::Vector3d c = chord(p, i);
-        residual(row) = c.norm() - (1.0 - shrink) * length_m[i];
-        jacobian.row(row++) = c.normalized().transpose();
-      }
-      const Eigen::Vector3d step = jacobian.fullPivLu().solve(-residual);
-      if (!step.allFinite()) break;
-      p.position_world += step;
-      converged = step.norm() < 1e-9;
-    }
-    const bool fourth_fits = chord(p, skipped).norm() <= (1.0 - shrink) * length_m[skipped];
-    if (converged && fourth_fits && p.position_world.z() < best_z) {
-      best = p;
-      best_z = p.position_world.z();
+    const std::optional<Pose> p = three_chord_pose(robot, length_m, shrink, pose, skipped);
+    if (p && p->position_world.z() < best_z) {
+      best = *p;
+      best_z = p->position_world.z();
     }
   }
   return best;
+}
+
+sim::SlackCables only(int cable) {
+  sim::SlackCables slack{};
+  slack[cable] = true;
+  return slack;
+}
+
+int slack_cable_of(const sim::Equilibrium& rest) {
+  for (int i = 0; i < kCableCount; ++i) {
+    if (rest.cables[i].slack) return i;
+  }
+  return -1;
 }
 
 }  // namespace
@@ -134,10 +159,7 @@ double RobotPhysics::natural_frequency_radps() const {
 
 double RobotPhysics::sway_period_s() const { return 2.0 * std::numbers::pi / omega_radps_; }
 
-void RobotPhysics::solve_rest() {
-  since_solve_s_ = 0.0;
-  std::array<double, kCableCount> unstretched_m{};
-  for (int i = 0; i < kCableCount; ++i) unstretched_m[i] = payout_m_[i] - robot_.encoder_offset_m[i];
+std::optional<sim::Equilibrium> RobotPhysics::solve_taut(const std::array<double, kCableCount>& unstretched_m) const {
   sim::SolverOptions solver;
   solver.segments = options_.segments;
   sim::EquilibriumResult next = sim::solve_forward_equilibrium(robot_, unstretched_m, rest_.world_T_platform, solver);
@@ -148,6 +170,49 @@ void RobotPhysics::solve_rest() {
     const Pose guess = hanging_chord_pose(robot_, unstretched_m, shrink, rest_.world_T_platform);
     next = sim::solve_forward_equilibrium(robot_, unstretched_m, guess, solver);
   }
+  if (!next) return std::nullopt;
+  return *next;
+}
+
+std::optional<sim::Equilibrium> RobotPhysics::solve_slack(const std::array<double, kCableCount>& unstretched_m,
+                                                          int cable) const {
+  sim::SolverOptions solver;
+  solver.segments = options_.segments;
+  // From the last rest pose while that cable was already slack, else from
+  // where the other three hang on straight chords.
+  sim::EquilibriumResult next = Unexpected{sim::EquilibriumFailure{}};
+  if (slack_cable_of(rest_) == cable) {
+    next = sim::solve_forward_equilibrium(robot_, unstretched_m, rest_.world_T_platform, solver, only(cable));
+  }
+  if (!next) {
+    const std::optional<Pose> guess = three_chord_pose(robot_, unstretched_m, 1e-3, rest_.world_T_platform, cable);
+    if (!guess) return std::nullopt;  // that cable is too short to hang slack
+    next = sim::solve_forward_equilibrium(robot_, unstretched_m, *guess, solver, only(cable));
+  }
+  if (!next) return std::nullopt;
+  return *next;
+}
+
+void RobotPhysics::solve_rest() {
+  since_solve_s_ = 0.0;
+  std::array<double, kCableCount> unstretched_m{};
+  for (int i = 0; i < kCableCount; ++i) unstretched_m[i] = payout_m_[i] - robot_.encoder_offset_m[i];
+  // A cable slack at the last rest most likely still is; else taut; else the
+  // lowest-hanging of the poses with one cable slack (least potential energy).
+  const int was_slack = slack_cable_of(rest_);
+  std::optional<sim::Equilibrium> next;
+  if (was_slack >= 0) next = solve_slack(unstretched_m, was_slack);
+  if (!next) next = solve_taut(unstretched_m);
+  if (!next) {
+    const auto com_height = [&](const sim::Equilibrium& rest) {
+      return rest.world_T_platform.transform(robot_.center_of_mass_platform()).z();
+    };
+    for (int cable = 0; cable < kCableCount; ++cable) {
+      if (cable == was_slack) continue;
+      const std::optional<sim::Equilibrium> candidate = solve_slack(unstretched_m, cable);
+      if (candidate && (!next || com_height(*candidate) < com_height(*next))) next = candidate;
+    }
+  }
   if (!next) {
     // Back off: a configuration without a taut rest pose (a cable slack on
     // the way) costs several failed solves, which would stall the real-time
@@ -157,6 +222,7 @@ void RobotPhysics::solve_rest() {
     return;  // keep the last rest state; a later solve from the moved cables may succeed
   }
   rest_ = *next;
+  if (slack_cable_of(rest_) >= 0) ++slack_solves_;
   solved_payout_m_ = payout_m_;
   omega_radps_ = natural_frequency_radps();
 }

@@ -24,10 +24,20 @@
 // equilibrium_interval_s of simulated time; between solves the platform
 // sways about the latest equilibrium; the cable tensions follow theirs with
 // a first-order lag of tension_time_constant_s.
+// Slack cables: when no rest pose with four taut cables is found for the
+// commanded lengths (a cable paid out beyond what the others leave it, or
+// far from the last rest pose), the platform hangs on three: the rest pose
+// with one cable slack (sim/equilibrium.h: no tension, at least as long as
+// its chord), the lowest-hanging one when several cables could be. Its
+// tension settles to 0, so a load cell on it reads 0; its encoder counts the
+// payout as ever; the sway's stiffness has no term from it. A heavy cable
+// paid out a little hangs in a deeper loop that still pulls with part of its
+// own weight: the taut solve finds that, and it is not slack.
 // Time: simulated seconds passed to advance(); no clock read here.
 // Not thread-safe.
 
 #include <array>
+#include <optional>
 #include <string>
 
 #include <Eigen/Core>
@@ -77,14 +87,20 @@ class RobotPhysics {
   double tension_n(int cable) const { return tension_n_[cable]; }
   // Tension change still to come [N]: how far the cable is from its rest value.
   double tension_unsettled_n(int cable) const { return std::abs(rest_.cables[cable].tension_n - tension_n_[cable]); }
-  // Equilibrium solves that failed (commanded lengths without a taut rest
-  // pose); the platform stays at the last equilibrium then.
+  // Equilibrium solves that failed (no rest pose found, taut or with one
+  // cable slack); the platform stays at the last equilibrium then.
   int failed_solves() const { return failed_solves_; }
+  // Equilibrium solves whose rest state has a slack cable.
+  int slack_solves() const { return slack_solves_; }
   const sim::TrueRobot& robot() const { return robot_; }
 
  private:
   RobotPhysics(const sim::TrueRobot& robot, const sim::Equilibrium& rest, const PhysicsOptions& options);
   void solve_rest();
+  // The rest state of `unstretched_m` with every cable taut, or with
+  // `cable` slack; none when the solve fails.
+  std::optional<sim::Equilibrium> solve_taut(const std::array<double, kCableCount>& unstretched_m) const;
+  std::optional<sim::Equilibrium> solve_slack(const std::array<double, kCableCount>& unstretched_m, int cable) const;
   // w of the sway at rest_ [rad/s] (see above).
   double natural_frequency_radps() const;
 
@@ -101,6 +117,7 @@ class RobotPhysics {
   std::array<double, kCableCount> solved_payout_m_{};  // payouts of rest_
   double since_solve_s_ = 0.0;
   int failed_solves_ = 0;
+  int slack_solves_ = 0;
 };
 
 }  // namespace cdpr::virtual_robot
