@@ -127,7 +127,7 @@ std::string format_calibration_toml(const Calibration& calibration) {
   append_line(out, "samples = " + std::to_string(calibration.samples), "rows fitted");
   if (!calibration.model_warning.empty()) {
     append_line(out, "model_warning = " + toml_string(calibration.model_warning),
-                "the model does not fit the data; sigmas scaled up by the misfit");
+                "why the model is not trusted (docs/FORMATS.md)");
   }
 
   for (std::size_t i = 0; i < calibration.winches.size(); ++i) {
