@@ -77,6 +77,9 @@ void add_held_out_information(const EffectPoseFactor& factor, const PosePriorFac
   for (int r = 0; r < 6; ++r) {
     for (int c = 0; c < 6; ++c) j_local(EffectPoseFactor::kResidualDim + r, c) = prior_jacobian[r * 6 + c];
   }
+  // No global unknowns (every anchor and offset held): nothing to add, and
+  // Eigen's solve on an empty right-hand side binds a null reference.
+  if (j_global.cols() == 0) return;
   const Eigen::MatrixXd lg = j_local.transpose() * j_global;
   h += j_global.transpose() * j_global - lg.transpose() * (j_local.transpose() * j_local).ldlt().solve(lg);
 }
