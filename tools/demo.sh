@@ -39,41 +39,18 @@ trap 'exit 130' INT TERM
 start=$(date +%s)
 echo "== virtual robot: large preset (240 x 220 x 50 m, 34 kg platform), physics 20x real time,"
 echo "   nominal anchors in robot.toml 0.3 m off the truth, encoder offsets unknown"
-"$build/tools/virtual-robot/virtual-robot" --preset large --seed "${DEMO_SEED:-7}" --time-scale 20 --anchor-perturbation 0.3 \
-  --modbus-transport rtu --load-cell-model flintec-ft-11 ${DEMO_EFFECTS:-} \
-  --endpoints "$work/robot" >"$work/virtual-robot.log" 2>&1 &
-pids+=($!)
-wait_for "$work/robot/ready" 60
+start_virtual_robot "$work" "$build" 20 "${DEMO_SEED:-7}" ${DEMO_EFFECTS:-}
 
-cat >"$work/cdpr-calibd.toml" <<EOF
-# cdpr-calibd against the virtual robot (keys: systemd/cdpr-calibd.toml)
-robot = "$work/robot/robot.toml"
-[store]
-state_dir = "$work/state"
-[control]
-socket = "$work/control"
-[winches]
-endpoint = "unix:$work/robot/can.sock"
 # The physics runs 20x faster: a 2 m/s cable pays out 40 m per real second.
-max_speed_mps = 100.0
 # The virtual robot's CANopen nodes and pose stream share one thread with its
 # physics, whose equilibrium solve can hold them past the shipped 500 ms
 # (a hard move, a busy machine); a real drive or tracker does not wait for
-# physics. Same for pose_stale_ms below.
-heartbeat_timeout_ms = 2000
-[load_cell]
-# The virtual FT-11 shows kilograms with two decimals.
-endpoint = "rtu:$work/robot/load_cell.tty"
-preset = "flintec-ft-11"
-decimals = 2
-[pose]
-endpoint = "unix:$work/robot/pose.sock"
-[button]
-kind = "none"
-[limits]
-settle_timeout_s = 15.0
-pose_stale_ms = 2000
-EOF
+# physics: hence the heartbeat and pose_stale_ms.
+write_daemon_config "$work" \
+  winches="max_speed_mps = 100.0
+heartbeat_timeout_ms = 2000" \
+  limits="settle_timeout_s = 15.0
+pose_stale_ms = 2000"
 
 echo "== cdpr-calibd (foreground, state in $work/state)"
 "$build/src/cdpr-calibd" --config "$work/cdpr-calibd.toml" 2>"$work/daemon.log" &

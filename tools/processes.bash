@@ -22,3 +22,59 @@ wait_for() {
   echo "$(basename "$0"): $1 did not appear within $2 s" >&2
   return 1
 }
+
+# Starts the virtual robot (large preset, nominal anchors 0.3 m off, an FT-11
+# load cell on Modbus RTU) with its endpoints in $1/robot, log in
+# $1/virtual-robot.log, and waits until it serves them.
+#   start_virtual_robot WORK BUILD TIME_SCALE SEED [more virtual-robot options]
+start_virtual_robot() {
+  local work=$1 build=$2 scale=$3 seed=$4
+  shift 4
+  "$build/tools/virtual-robot/virtual-robot" --preset large --seed "$seed" --time-scale "$scale" \
+    --anchor-perturbation 0.3 --modbus-transport rtu --load-cell-model flintec-ft-11 "$@" \
+    --endpoints "$work/robot" >"$work/virtual-robot.log" 2>&1 &
+  pids+=($!)
+  wait_for "$work/robot/ready" 60
+}
+
+# Writes $1/cdpr-calibd.toml: the daemon against the robot start_virtual_robot
+# started in $1, state in $1/state, control socket $1/control. Each further
+# argument SECTION=LINES adds TOML lines to that section ("drive" is
+# [winches.drive]); the keys are those of systemd/cdpr-calibd.toml.
+#   write_daemon_config WORK [winches=...] [load_cell=...] [limits=...] ...
+write_daemon_config() {
+  local work=$1
+  shift
+  local -A keys=()
+  local arg
+  for arg in "$@"; do keys[${arg%%=*}]=${arg#*=}; done
+  cat >"$work/cdpr-calibd.toml" <<CONFIG
+# cdpr-calibd against the virtual robot (keys: systemd/cdpr-calibd.toml)
+robot = "$work/robot/robot.toml"
+[store]
+state_dir = "$work/state"
+[control]
+socket = "$work/control"
+[winches]
+endpoint = "unix:$work/robot/can.sock"
+${keys[winches]:-}
+[winches.drive]
+${keys[drive]:-}
+[load_cell]
+# The virtual FT-11 shows kilograms with two decimals.
+endpoint = "rtu:$work/robot/load_cell.tty"
+preset = "flintec-ft-11"
+decimals = 2
+${keys[load_cell]:-}
+[pose]
+endpoint = "unix:$work/robot/pose.sock"
+[button]
+kind = "none"
+[equilibrium]
+${keys[equilibrium]:-}
+[waypoints]
+${keys[waypoints]:-}
+[limits]
+${keys[limits]:-}
+CONFIG
+}

@@ -12,7 +12,7 @@
 # and the sway estimate's:
 #   EQUILIBRIUM_KEYS='estimate_sway = false' LIMITS_KEYS='settle_timeout_s = 900' \
 #     tools/robot-time.sh build out-wait
-# Only fault timeouts are loosened (CANopen heartbeat, pose, load cell: the
+# Only fault timeouts are loosened (CANopen heartbeats both ways, pose, load cell: the
 # virtual robot's nodes share a thread with its physics, and a loaded machine
 # delays them); no equilibrium threshold is. OUT_DIR keeps the status log,
 # the daemon's log, its state (calibration.toml, history) and the robot's
@@ -38,40 +38,18 @@ cleanup() {
 trap cleanup EXIT
 trap 'exit 130' INT TERM
 
-"$build/tools/virtual-robot/virtual-robot" --preset large --seed "${SEED:-7}" --time-scale "$scale" \
-  --anchor-perturbation 0.3 --modbus-transport rtu --load-cell-model flintec-ft-11 \
-  --endpoints "$work/robot" >"$work/virtual-robot.log" 2>&1 &
-pids+=($!)
-wait_for "$work/robot/ready" 60
+start_virtual_robot "$work" "$build" "$scale" "${SEED:-7}"
 
-cat >"$work/cdpr-calibd.toml" <<EOF
-robot = "$work/robot/robot.toml"
-[store]
-state_dir = "$work/state"
-[control]
-socket = "$work/control"
-[winches]
-endpoint = "unix:$work/robot/can.sock"
 # 5 m/s of robot time, in the daemon's clock.
-max_speed_mps = $(awk -v s="$scale" 'BEGIN { print 5.0 * s }')
-heartbeat_timeout_ms = 5000
-[load_cell]
-endpoint = "rtu:$work/robot/load_cell.tty"
-preset = "flintec-ft-11"
-decimals = 2
-fault_timeout_ms = 10000
-[pose]
-endpoint = "unix:$work/robot/pose.sock"
-[button]
-kind = "none"
-[equilibrium]
-${EQUILIBRIUM_KEYS:-}
-[waypoints]
-${WAYPOINTS_KEYS:-}
-[limits]
-pose_stale_ms = 5000
-${LIMITS_KEYS:-}
-EOF
+write_daemon_config "$work" \
+  winches="max_speed_mps = $(awk -v s="$scale" 'BEGIN { print 5.0 * s }')
+heartbeat_timeout_ms = 5000" \
+  drive="consumer_heartbeat_ms = 5000" \
+  load_cell="fault_timeout_ms = 10000" \
+  equilibrium="${EQUILIBRIUM_KEYS:-}" \
+  waypoints="${WAYPOINTS_KEYS:-}" \
+  limits="pose_stale_ms = 5000
+${LIMITS_KEYS:-}"
 
 "$build/src/cdpr-calibd" --config "$work/cdpr-calibd.toml" 2>"$work/daemon.log" &
 pids+=($!)
