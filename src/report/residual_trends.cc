@@ -42,8 +42,12 @@ std::vector<ResidualSeries> residual_series(const HeldOutEvaluation& held_out) {
     ResidualSeries by_order{encoder, kSampleOrder, "m", i, {}, {}};
     ResidualSeries height{"height " + std::to_string(i), "platform height [m]", "m", i, {}, {}};
     for (const HeldOutPose& pose : held_out.poses) {
-      const double r = pose.prediction.encoder_residual_m[i];
       const double z = pose.world_T_platform.position_world.z();
+      height.x.push_back(z);
+      height.residual.push_back(pose.prediction.height_residual_m[i]);
+      // A reading left out as a gross error is no trend of the model's.
+      if (pose.sample.encoder_left_out[i]) continue;
+      const double r = pose.prediction.encoder_residual_m[i];
       by_length.x.push_back(pose.prediction.payout_m[i]);
       by_length.residual.push_back(r);
       by_tension.x.push_back(pose.prediction.tension_n[i]);
@@ -52,8 +56,6 @@ std::vector<ResidualSeries> residual_series(const HeldOutEvaluation& held_out) {
       by_height.residual.push_back(r);
       by_order.x.push_back(pose.sample.id);
       by_order.residual.push_back(r);
-      height.x.push_back(z);
-      height.residual.push_back(pose.prediction.height_residual_m[i]);
     }
     for (ResidualSeries* s : {&by_length, &by_tension, &by_height, &height, &by_order}) series.push_back(std::move(*s));
   }
@@ -61,6 +63,7 @@ std::vector<ResidualSeries> residual_series(const HeldOutEvaluation& held_out) {
   ResidualSeries force_height{"load cell", "platform height [m]", "N", -1, {}, {}};
   ResidualSeries force_order{"load cell", kSampleOrder, "N", -1, {}, {}};
   for (const HeldOutPose& pose : held_out.poses) {
+    if (pose.sample.force_left_out) continue;
     force.x.push_back(pose.sample.force_n);
     force.residual.push_back(pose.prediction.force_residual_n);
     force_height.x.push_back(pose.world_T_platform.position_world.z());

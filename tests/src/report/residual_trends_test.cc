@@ -47,6 +47,22 @@ TEST(ResidualTrends, OppositeDriftsChangeRatherThanGrow) {
   EXPECT_NE(text.find("encoder residuals change with sample order on cables 1 and 2"), std::string::npos) << text;
 }
 
+TEST(ResidualTrends, AReadingLeftOutAsAGrossErrorMakesNoTrend) {
+  // GIVEN no drift, but the last pose's encoder 3 and load cell wrong by 1.4 m and 300 N and left out
+  HeldOutEvaluation h = poses_with_drift({});
+  HeldOutPose& last = h.poses.back();
+  last.prediction.encoder_residual_m[3] += 1.4;
+  last.prediction.force_residual_n += 300.0;
+  last.sample.encoder_left_out[3] = true;
+  last.sample.force_left_out = true;
+  // THEN no trend is significant, and the series leave those readings out
+  for (const Trend& t : residual_trends(h)) EXPECT_GT(t.p_value, 1e-3) << t.sensor << " vs " << t.against;
+  for (const ResidualSeries& s : residual_series(h)) {
+    const bool left_out = s.sensor == "encoder 3" || s.sensor == "load cell";
+    EXPECT_EQ(s.x.size(), h.poses.size() - (left_out ? 1 : 0)) << s.sensor << " vs " << s.against;
+  }
+}
+
 TEST(ResidualTrends, NoTrendsNoWords) { EXPECT_EQ(strongest_trend_text({}), ""); }
 
 }  // namespace
