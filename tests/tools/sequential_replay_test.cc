@@ -2,6 +2,8 @@
 // here; cdpr-accuracy --strategy runs the full table of docs/calibration.md).
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "cdpr-accuracy/replay.h"
 
 namespace cdpr::accuracy {
@@ -35,6 +37,25 @@ TEST(SequentialReplay, ReachesTheTargetInAtMostTwoThirdsOfTheSpreadPlansTime) {
     EXPECT_LT(r.waypoints, spread.waypoints);
     EXPECT_LT(r.robot_time_s, 2.0 / 3.0 * spread.robot_time_s);
   }
+}
+
+TEST(SequentialReplay, JudgesEachRunsSigmasAgainstTheFitsOwnCovariance) {
+  // GIVEN a sequential run on the large robot
+  const ReplayResult r = replay(large_case(Strategy::kSequential), 2);
+  ASSERT_TRUE(r.ok) << r.message;
+  // THEN its 16 anchor-axis and offset errors are judged: the same RMS as
+  // the error/sigma column, with the spread that honest sigmas with these
+  // correlations would give it
+  const NormalisedErrors& e = r.normalised;
+  ASSERT_EQ(e.count, 16);
+  EXPECT_NEAR(e.rms, std::sqrt(r.normalised_sq_sum / r.normalised_count), 1e-12);
+  EXPECT_GT(e.mahalanobis, 0.0);
+  EXPECT_LT(e.rms_q05, 1.0);
+  EXPECT_GT(e.rms_q95, 1.0);
+  // AND the anchors' shared frame and offsets correlate the errors: honest
+  // sigmas leave the RMS outside 0.7-1.5 far more often than independent
+  // errors would (5 %)
+  EXPECT_GT(e.p_outside, 0.1);
 }
 
 TEST(SequentialReplay, StopsAtMaxCountWhenTheTargetIsOutOfReach) {

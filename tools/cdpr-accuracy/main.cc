@@ -8,12 +8,53 @@
 #include "cdpr-accuracy/accuracy.h"
 #include "cdpr-accuracy/model_check.h"
 #include "cdpr-accuracy/replay.h"
+#include "solver/calibration/chi_square.h"
 #include "version/version.h"
 
 namespace {
 
 void print_row(const char* what, const cdpr::accuracy::Distribution& d) {
   std::printf("  %-22s mean %8.4f  median %8.4f  p90 %8.4f  worst %8.4f\n", what, d.mean, d.median, d.p90, d.worst);
+}
+
+// Per run: the error/sigma RMS against what the fit's own covariance
+// predicts of it, and the Mahalanobis statistic (normalised_errors.h).
+void print_run_honesty(const cdpr::accuracy::NormalisedErrors& e) {
+  if (e.count == 0) return;
+  std::printf("    error/sigma RMS %.2f, honest 90 %% range %.2f-%.2f (rank %.2f), P(outside %.1f-%.1f) %.2f; "
+              "Mahalanobis e'C^-1e/n %.2f (p %.2f)\n",
+              e.rms, e.rms_q05, e.rms_q95, e.rms_rank, cdpr::accuracy::kHonestRmsLow, cdpr::accuracy::kHonestRmsHigh,
+              e.p_outside, e.mahalanobis, e.mahalanobis_p);
+}
+
+// Over the runs: how many per-run RMS fall outside the bounds against how
+// many honest sigmas with each run's correlations would put there, and
+// whether the Mahalanobis statistics follow chi-square(n) / n.
+void print_honesty_summary(const std::vector<cdpr::accuracy::ReplayResult>& runs) {
+  using cdpr::accuracy::kHonestRmsHigh;
+  using cdpr::accuracy::kHonestRmsLow;
+  int runs_stated = 0, outside = 0, mahalanobis_tail = 0, dof = 0;
+  double expected_outside = 0.0, mahalanobis_sum = 0.0, rank_sum = 0.0, low = 1e300, high = 0.0;
+  for (const auto& r : runs) {
+    const cdpr::accuracy::NormalisedErrors& e = r.normalised;
+    if (e.count == 0) continue;
+    ++runs_stated;
+    outside += e.rms < kHonestRmsLow || e.rms > kHonestRmsHigh;
+    expected_outside += e.p_outside;
+    mahalanobis_sum += e.mahalanobis * e.count;
+    dof += e.count;
+    mahalanobis_tail += e.mahalanobis_p < 0.05 || e.mahalanobis_p > 0.95;
+    rank_sum += e.rms_rank;
+    low = std::min(low, e.rms);
+    high = std::max(high, e.rms);
+  }
+  if (runs_stated == 0) return;
+  std::printf("  per run: error/sigma RMS %.2f-%.2f, %d of %d outside %.1f-%.1f (honest sigmas with each run's "
+              "correlations: %.1f expected), mean rank %.2f (honest 0.50); Mahalanobis mean %.2f (honest 1.00, pooled "
+              "p %.2f), %d of %d runs in its 5 %% tails (honest %.1f)\n",
+              low, high, outside, runs_stated, kHonestRmsLow, kHonestRmsHigh, expected_outside, rank_sum / runs_stated,
+              mahalanobis_sum / dof, cdpr::chi_square_upper_tail(mahalanobis_sum, dof), mahalanobis_tail, runs_stated,
+              0.1 * runs_stated);
 }
 
 // --strategy: replays a waypoint strategy per seed and prints its table row.
@@ -33,6 +74,7 @@ int run_replay(const cdpr::accuracy::ReplayCase& c, const std::string& preset_na
                   r.normalised_count ? std::sqrt(r.normalised_sq_sum / r.normalised_count) : 0.0,
                   r.forecast_abs_error, r.forecast_bias, r.stop.empty() ? "" : " stop: ",
                   r.stop.c_str(), r.ok ? "" : r.message.c_str());
+      print_run_honesty(r.normalised);
     } else {
       std::fprintf(stderr, "\r%s: run %d/%d", strategy.c_str(), s + 1, seeds);
     }
@@ -58,6 +100,7 @@ int run_replay(const cdpr::accuracy::ReplayCase& c, const std::string& preset_na
               preset_name.c_str(), c.anchor_perturbation_m, strategy.c_str(), time_s / 60.0, waypoints, anchor, worst,
               offset, count ? std::sqrt(sq / count) : 0.0, static_cast<int>(runs.size()), failures, travel,
               nn > 0.0 ? (", nearest neighbour alone " + std::to_string(static_cast<int>(nn + 0.5)) + " m").c_str() : "");
+  print_honesty_summary(runs);
   return failures ? 1 : 0;
 }
 
@@ -146,7 +189,8 @@ int main(int argc, char** argv) {
                  "sequential: candidate grid xy,z (default: the daemon's [waypoints] grid_xy, grid_z)")
       ->delimiter(',')->expected(2)->check(CLI::PositiveNumber);
   app.add_flag("--model-check", model_check_only, "only run the Table I model check");
-  app.add_flag("-v,--verbose", verbose, "one line per run");
+  app.add_flag("-v,--verbose", verbose,
+               "one line per run (--strategy: and a line judging its sigmas against the fit's own covariance)");
   CLI11_PARSE(app, argc, argv);
 
   const cdpr::sim::Preset preset = *cdpr::sim::parse_preset(preset_name);

@@ -70,6 +70,7 @@ void score(const sim::SimulatedDataset& data, const CalibrationResult& fit, Repl
   r.message = fit.message;
   if (!fit.ok) return;
   const int n = kCableCount;
+  Eigen::VectorXd errors(4 * n), sigmas(4 * n);  // per cable: anchor axes, offset (global_covariance's order)
   for (int i = 0; i < n; ++i) {
     const WinchCalibration& w = fit.calibration.winches[i];
     const WinchTruth& truth = data.truth.winches[i];
@@ -82,7 +83,12 @@ void score(const sim::SimulatedDataset& data, const CalibrationResult& fit, Repl
     r.largest_offset_sigma_m = std::max(r.largest_offset_sigma_m, w.offset_sigma_m);
     r.normalised_sq_sum += error.cwiseQuotient(w.anchor_sigma).squaredNorm() + std::pow(offset_error / w.offset_sigma_m, 2);
     r.normalised_count += 4;
+    errors.segment<3>(4 * i) = error;
+    errors(4 * i + 3) = offset_error;
+    sigmas.segment<3>(4 * i) = w.anchor_sigma;
+    sigmas(4 * i + 3) = w.offset_sigma_m;
   }
+  r.normalised = normalised_errors(errors, sigmas, fit.global_covariance);
 }
 
 }  // namespace

@@ -29,6 +29,7 @@
 #include <cstdint>
 #include <string>
 
+#include "cdpr-accuracy/normalised_errors.h"
 #include "sim/presets.h"
 #include "src/calibration/sequential_planner.h"
 #include "src/calibration/waypoint_planner.h"
@@ -70,6 +71,8 @@ struct ReplayResult {
   double largest_anchor_sigma_m = 0.0, largest_offset_sigma_m = 0.0;  // final fit
   double normalised_sq_sum = 0.0;     // (error / sigma)^2 over anchor axes and offsets
   int normalised_count = 0;
+  // The same errors against the final fit's full covariance.
+  NormalisedErrors normalised;
 };
 
 // The daemon's planner settings for the preset's robot (waypoint box, limits).
