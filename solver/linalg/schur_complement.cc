@@ -61,27 +61,6 @@ SchurComplement::BlockKernel kernel_for(int da, int db) {
   }
 }
 
-// dst(i, c) = block(i, c) for a row-major m x d block into rows of stride
-// `ld`: d fixed for the tangent sizes that occur (D > 0), so each row is a
-// few moves (a generic loop, or std::copy's memmove per row, cost several
-// times more than the values); D = 0 takes the runtime `dim`.
-template <int D>
-void copy_block_columns(int m, int dim, const double* block, double* dst, int ld) {
-  const int d = D > 0 ? D : dim;
-  for (int i = 0; i < m; ++i) {
-    for (int c = 0; c < d; ++c) dst[i * ld + c] = block[i * d + c];
-  }
-}
-void copy_block_columns(int m, int d, const double* block, double* dst, int ld) {
-  switch (d) {
-    case 1: return copy_block_columns<1>(m, d, block, dst, ld);
-    case 2: return copy_block_columns<2>(m, d, block, dst, ld);
-    case 3: return copy_block_columns<3>(m, d, block, dst, ld);
-    case 6: return copy_block_columns<6>(m, d, block, dst, ld);
-    default: return copy_block_columns<0>(m, d, block, dst, ld);
-  }
-}
-
 }  // namespace
 
 std::unique_ptr<SchurComplement> SchurComplement::create(BlockJacobian& jacobian, const EliminationOrder& order) {
