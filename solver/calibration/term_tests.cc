@@ -13,6 +13,7 @@
 #include "solver/calibration/chi_square.h"
 #include "solver/calibration/effect_pose_factor.h"
 #include "solver/calibration/pose_prior_factor.h"
+#include "solver/linalg/block_copy.h"
 #include "solver/linalg/dense_kernels.h"
 #include "solver/linalg/group_kernels.h"
 

@@ -29,6 +29,9 @@ void add_transposed_product_portable(int depth, int rows, int cols, const double
 // out[c] += sign * sum_{k < depth} x(k, c) v[k] for c < cols (x' v).
 void add_transposed_times_vector(int depth, int cols, const double* x, int ldx, const double* v, double sign,
                                  double* out);
+// ... in pairs of doubles whatever the processor (as add_transposed_product_portable).
+void add_transposed_times_vector_portable(int depth, int cols, const double* x, int ldx, const double* v,
+                                          double sign, double* out);
 
 // out[k] -= sum_{c < cols} x(k, c) v[c] for k < rows (x v).
 void subtract_times_vector(int rows, int cols, const double* x, int ldx, const double* v, double* out);
@@ -43,28 +46,8 @@ bool all_finite(const double* v, std::size_t n);
 // the reciprocals of its diagonal) and the d x m row-major B and W (forward
 // substitution, a whole row at a time).
 void solve_upper_transposed_rows(int d, const double* u, const double* inverse, int m, const double* b, double* w);
-
-// dst(i, c) = block(i, c) for a row-major m x d block into rows of stride
-// `ld` (a factor's Jacobian block into a wider row-major matrix): d fixed
-// for the tangent sizes that occur (D > 0), so each row is a few moves (a
-// generic loop, or std::copy's memmove per row, cost several times more
-// than the values); D = 0 takes the runtime d. Inline: it runs once per
-// block of every factor.
-template <int D>
-inline void copy_block_columns_sized(int m, int d, const double* block, double* dst, int ld) {
-  if constexpr (D > 0) d = D;
-  for (int i = 0; i < m; ++i) {
-    for (int c = 0; c < d; ++c) dst[i * ld + c] = block[i * d + c];
-  }
-}
-inline void copy_block_columns(int m, int d, const double* block, double* dst, int ld) {
-  switch (d) {
-    case 1: return copy_block_columns_sized<1>(m, d, block, dst, ld);
-    case 2: return copy_block_columns_sized<2>(m, d, block, dst, ld);
-    case 3: return copy_block_columns_sized<3>(m, d, block, dst, ld);
-    case 6: return copy_block_columns_sized<6>(m, d, block, dst, ld);
-    default: return copy_block_columns_sized<0>(m, d, block, dst, ld);
-  }
-}
+// ... in pairs of doubles whatever the processor (as add_transposed_product_portable).
+void solve_upper_transposed_rows_portable(int d, const double* u, const double* inverse, int m, const double* b,
+                                          double* w);
 
 }  // namespace cdpr

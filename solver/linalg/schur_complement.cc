@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 
+#include "solver/linalg/block_copy.h"
 #include "solver/linalg/dense_kernels.h"
 #include "solver/linalg/group_kernels.h"
 

@@ -152,5 +152,40 @@ TEST(DenseKernels, RowWiseForwardSubstitutionSolvesUTransposedW) {
   }
 }
 
+// The other two AVX2 kernels against their portable versions, bit for bit.
+TEST(DenseKernels, Avx2VectorProductAndSubstitutionGiveThePortableBits) {
+#ifndef CDPR_AVX2_KERNELS
+  GTEST_SKIP() << "not an x86-64 build";
+#else
+  if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this processor has no AVX2";
+  std::mt19937 rng(8);
+  for (int depth : {0, 1, 7, 9}) {
+    for (int cols = 1; cols <= 37; ++cols) {  // blocks of sixteen, quads and single columns
+      const RowMajor x = random_matrix(depth, cols + 1, rng);
+      const Eigen::VectorXd v = Eigen::VectorXd::Random(depth);
+      const Eigen::VectorXd start = Eigen::VectorXd::Random(cols);
+      Eigen::VectorXd portable = start, wide = start;
+      add_transposed_times_vector_portable(depth, cols, x.data(), cols + 1, v.data(), -3.0, portable.data());
+      avx2::add_transposed_times_vector(depth, cols, x.data(), cols + 1, v.data(), -3.0, wide.data());
+      for (int c = 0; c < cols; ++c) ASSERT_EQ(portable(c), wide(c)) << depth << " " << cols;
+    }
+  }
+  for (int d : {1, 2, 6, 8}) {
+    for (int m = 1; m <= 29; ++m) {
+      Eigen::MatrixXd u = Eigen::MatrixXd::Random(d, d).triangularView<Eigen::Upper>();
+      u.diagonal().array() += 3.0;
+      const Eigen::VectorXd inverse = u.diagonal().cwiseInverse();
+      const RowMajor b = random_matrix(d, m, rng);
+      RowMajor portable(d, m), wide(d, m);
+      solve_upper_transposed_rows_portable(d, u.data(), inverse.data(), m, b.data(), portable.data());
+      avx2::solve_upper_transposed_rows(d, u.data(), inverse.data(), m, b.data(), wide.data());
+      for (int i = 0; i < d; ++i) {
+        for (int q = 0; q < m; ++q) ASSERT_EQ(portable(i, q), wide(i, q)) << d << " " << m;
+      }
+    }
+  }
+#endif
+}
+
 }  // namespace
 }  // namespace cdpr
