@@ -206,6 +206,13 @@ void subtract_times_vector(int rows, int cols, const double* x, int ldx, const d
 }
 
 bool all_finite(const double* v, std::size_t n) {
+#ifdef CDPR_AVX2_KERNELS
+  if (use_avx2()) return avx2::all_finite(v, n);
+#endif
+  return all_finite_portable(v, n);
+}
+
+bool all_finite_portable(const double* v, std::size_t n) {
   Pair s0 = {}, s1 = {};
   const Pair zero = {};
   std::size_t i = 0;

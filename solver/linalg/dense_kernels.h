@@ -41,6 +41,8 @@ void subtract_times_vector(int rows, int cols, const double* x, int ldx, const d
 // per value, or scalar sums, cost several times more on the solver's
 // whole Jacobian buffers).
 bool all_finite(const double* v, std::size_t n);
+// ... in pairs of doubles whatever the processor (as add_transposed_product_portable).
+bool all_finite_portable(const double* v, std::size_t n);
 
 // W = U'^-1 B for the d x d upper triangular U (column-major; `inverse`:
 // the reciprocals of its diagonal) and the d x m row-major B and W (forward

@@ -183,4 +183,16 @@ void solve_upper_transposed_rows(int d, const double* u, const double* inverse, 
   }
 }
 
+bool all_finite(const double* v, std::size_t n) {
+  Quad s0 = {}, s1 = {};
+  const Quad zero = {};
+  std::size_t i = 0;
+  for (; i + 8 <= n; i += 8) {
+    s0 += load(v + i) * zero;
+    s1 += load(v + i + 4) * zero;
+  }
+  const Quad sum = s0 + s1;
+  return sum[0] + sum[1] + sum[2] + sum[3] == 0.0 && cdpr::all_finite_portable(v + i, n - i);
+}
+
 }  // namespace cdpr::avx2

@@ -4,7 +4,9 @@
 #include "solver/linalg/dense_kernels_avx2.h"
 #endif
 
+#include <limits>
 #include <random>
+#include <vector>
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
@@ -185,6 +187,28 @@ TEST(DenseKernels, Avx2VectorProductAndSubstitutionGiveThePortableBits) {
     }
   }
 #endif
+}
+
+TEST(DenseKernels, AllFiniteFindsAnInfinityOrNaNAnywhere) {
+  using Check = bool (*)(const double*, std::size_t);
+  std::vector<Check> checks = {all_finite, all_finite_portable};
+#ifdef CDPR_AVX2_KERNELS
+  if (__builtin_cpu_supports("avx2")) checks.push_back(avx2::all_finite);
+#endif
+  for (Check check : checks) {
+    for (std::size_t n = 0; n <= 21; ++n) {
+      std::vector<double> v(n, 1.5);
+      EXPECT_TRUE(check(v.data(), n)) << n;
+      for (std::size_t at = 0; at < n; ++at) {
+        for (double bad : {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                           std::numeric_limits<double>::quiet_NaN()}) {
+          v[at] = bad;
+          EXPECT_FALSE(check(v.data(), n)) << n << " " << at;
+          v[at] = 1.5;
+        }
+      }
+    }
+  }
 }
 
 }  // namespace
