@@ -13,6 +13,9 @@
 #include "solver/calibration/chi_square.h"
 #include "solver/calibration/effect_pose_factor.h"
 #include "solver/calibration/pose_prior_factor.h"
+#include "solver/linalg/block_copy.h"
+#include "solver/linalg/dense_kernels.h"
+#include "solver/linalg/group_kernels.h"
 
 namespace cdpr {
 namespace {
@@ -25,8 +28,6 @@ constexpr double kIdentifiableShare = 1e-10;
 constexpr int kLocalDim = 8;                  // pose tangent (6) and reference force (2)
 constexpr int kBaseGlobalDim = 4 * kCableCount;  // anchor (3) and offset (1) per cable
 constexpr int kPriorRows = 6;
-
-using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 bool in_model(const CalibrationOptions& options, Effect e) {
   return std::find(options.effects.begin(), options.effects.end(), e) != options.effects.end();
@@ -121,18 +122,27 @@ bool reduce(const Robot& robot, const CalibrationOptions& options, const Calibra
   std::vector<double*> jacobians;
   for (int d : block_dims) blocks.emplace_back(EffectPoseFactor::kResidualDim * d, 0.0);
   for (auto& b : blocks) jacobians.push_back(b.data());
-  std::array<double, 36> prior_block{};
-  double* prior_jacobians[] = {prior_block.data()};
+  std::array<double, kPriorRows * 6> prior_jacobian{};
+  double* prior_jacobians[] = {prior_jacobian.data()};
 
   const Loss loss{options.huber_width};
-  // Every pose's global rows and their eliminated part, stacked, so that
-  // S and b come from two products over all poses at the end.
+  // Per pose, with J_l its own columns (pose, reference force), J_g the
+  // global ones (its factor's rows only: the prior reaches the pose alone)
+  // and A = J_l'J_l (the prior's rows included) = U'U: W = U'^-1 J_l'J_g,
+  // so the pose adds J_g'J_g - W'W to S and J_g'r - W'U'^-1 J_l'r to b,
+  // straight into S's upper triangle: no stacked rows, no products over
+  // all poses at the end. The dense kernels take row-major blocks and
+  // fill column-major S and A.
   constexpr int kFactorRows = EffectPoseFactor::kResidualDim;
+  std::vector<double> global(kFactorRows * g), coupling(kLocalDim * g), eliminated(kLocalDim * g);
+  std::vector<double> reduced(static_cast<std::size_t>(g) * g, 0.0), own(g, 0.0);
+  std::array<double, kFactorRows * kLocalDim> local;
+  std::array<double, kLocalDim * kLocalDim> a;
+  std::array<double, kLocalDim> inverse, local_gradient;
+  std::array<double, kFactorRows> residual;
+  std::array<double, kPriorRows> prior_residual;
+  out.gradient = Eigen::VectorXd::Zero(g);
   const int n = static_cast<int>(result.fitted_rows.size());
-  Eigen::MatrixXd rows(n * kFactorRows, g), eliminated(n * kLocalDim, g);
-  Eigen::VectorXd row_residuals(n * kFactorRows), eliminated_residuals(n * kLocalDim);
-  Eigen::Matrix<double, kFactorRows, kLocalDim> local;
-  Eigen::Matrix<double, kPriorRows, 1> prior_residual;
   for (int k = 0; k < n; ++k) {
     const FittedRow& row = result.fitted_rows[k];
     const Eigen::Vector3d& p = row.world_T_platform.position_world;
@@ -144,41 +154,47 @@ bool reduce(const Robot& robot, const CalibrationOptions& options, const Calibra
                                 sigma.orientation_rad, loss);
     const EffectPoseFactor factor(robot, k, row.sample, options.height_sigma_m, loss, x.effects);
     double cost = 0.0;
-    auto global = rows.middleRows(k * kFactorRows, kFactorRows);
-    auto residual = row_residuals.segment(k * kFactorRows, kFactorRows);
     if (!prior.evaluate(parameters.data(), prior_residual.data(), prior_jacobians, &cost)) return false;
     if (!factor.evaluate(parameters.data(), residual.data(), jacobians.data(), &cost)) return false;
     for (std::size_t b = 0; b < blocks.size(); ++b) {
-      const Eigen::Map<const RowMajor> block(blocks[b].data(), kFactorRows, block_dims[b]);
-      if (b < 2) local.middleCols(b == 0 ? 0 : 6, block_dims[b]) = block;
-      else global.middleCols(block_column[b], block_dims[b]) = block;
+      const int d = block_dims[b];
+      const int column = b == 0 ? 0 : b == 1 ? 6 : block_column[b];
+      double* target = b < 2 ? local.data() + column : global.data() + column;
+      const int stride = b < 2 ? kLocalDim : g;
+      copy_block_columns(kFactorRows, d, blocks[b].data(), target, stride);
     }
-    if (!residual.allFinite() || !prior_residual.allFinite() || !local.allFinite() || !global.allFinite()) {
+    if (!all_finite(residual.data(), residual.size()) || !all_finite(prior_residual.data(), prior_residual.size()) ||
+        !all_finite(local.data(), local.size()) || !all_finite(prior_jacobian.data(), prior_jacobian.size()) ||
+        !all_finite(global.data(), global.size())) {
       return false;
     }
-    // The pose prior reaches the pose only.
-    const Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> prior_jacobian(prior_block.data());
-    Eigen::Matrix<double, kLocalDim, kLocalDim> a = local.transpose() * local;
-    a.topLeftCorner<6, 6>() += prior_jacobian.transpose() * prior_jacobian;
-    Eigen::Matrix<double, kLocalDim, 1> local_gradient = local.transpose() * residual;
-    local_gradient.head<6>() += prior_jacobian.transpose() * prior_residual;
-    const Eigen::LLT<Eigen::Matrix<double, kLocalDim, kLocalDim>> a_factor(a);
-    if (a_factor.info() != Eigen::Success) return false;
-    // With A = L L': B' A^-1 B = (L^-1 B)' (L^-1 B), B = J_l' J_g.
-    Eigen::Matrix<double, kLocalDim, kFactorRows> to_local = local.transpose();
-    a_factor.matrixL().solveInPlace(to_local);
-    a_factor.matrixL().solveInPlace(local_gradient);
-    eliminated.middleRows(k * kLocalDim, kLocalDim).noalias() = to_local.lazyProduct(global);
-    eliminated_residuals.segment<kLocalDim>(k * kLocalDim) = local_gradient;
+    a.fill(0.0);
+    add_transposed_product(kFactorRows, kLocalDim, kLocalDim, local.data(), kLocalDim, local.data(), kLocalDim,
+                           a.data(), kLocalDim, 1.0, true);
+    add_transposed_product(kPriorRows, 6, 6, prior_jacobian.data(), 6, prior_jacobian.data(), 6, a.data(), kLocalDim,
+                           1.0, true);
+    if (!group_kernels::cholesky_upper<kLocalDim>(a.data(), kLocalDim, inverse.data())) return false;
+    local_gradient.fill(0.0);
+    add_transposed_times_vector(kFactorRows, kLocalDim, local.data(), kLocalDim, residual.data(), 1.0,
+                                local_gradient.data());
+    add_transposed_times_vector(kPriorRows, 6, prior_jacobian.data(), 6, prior_residual.data(), 1.0,
+                                local_gradient.data());
+    group_kernels::solve_upper_transposed<kLocalDim>(a.data(), inverse.data(), kLocalDim, local_gradient.data());
+    // J_l'J_g as g x 8 column-major: the 8 x g row-major coupling.
+    std::fill(coupling.begin(), coupling.end(), 0.0);
+    add_transposed_product(kFactorRows, g, kLocalDim, global.data(), g, local.data(), kLocalDim, coupling.data(), g,
+                           1.0, false);
+    solve_upper_transposed_rows(kLocalDim, a.data(), inverse.data(), g, coupling.data(), eliminated.data());
+    add_transposed_product(kFactorRows, g, g, global.data(), g, global.data(), g, reduced.data(), g, 1.0, true);
+    add_transposed_product(kLocalDim, g, g, eliminated.data(), g, eliminated.data(), g, reduced.data(), g, -1.0, true);
+    add_transposed_times_vector(kFactorRows, g, global.data(), g, residual.data(), 1.0, out.gradient.data());
+    add_transposed_times_vector(kLocalDim, g, eliminated.data(), g, local_gradient.data(), -1.0, out.gradient.data());
+    for (int r = 0; r < kFactorRows; ++r) {
+      for (int c = 0; c < g; ++c) own[c] += global[r * g + c] * global[r * g + c];
+    }
   }
-  // Symmetric: the lower triangles alone, then mirrored.
-  out.matrix = Eigen::MatrixXd::Zero(g, g);
-  out.matrix.selfadjointView<Eigen::Lower>().rankUpdate(rows.transpose(), 1.0);
-  out.matrix.selfadjointView<Eigen::Lower>().rankUpdate(eliminated.transpose(), -1.0);
-  out.matrix.triangularView<Eigen::StrictlyUpper>() = out.matrix.transpose();
-  out.gradient.noalias() = rows.transpose() * row_residuals;
-  out.gradient.noalias() -= eliminated.transpose() * eliminated_residuals;
-  out.own = rows.colwise().squaredNorm().transpose();
+  out.matrix = Eigen::Map<const Eigen::MatrixXd>(reduced.data(), g, g).selfadjointView<Eigen::Upper>();
+  out.own = Eigen::Map<const Eigen::VectorXd>(own.data(), g);
   return true;
 }
 

@@ -108,15 +108,39 @@ void column_tiles(int depth, int row_end, int c, const double* x, int ldx, const
 
 }  // namespace
 
+// The J^T J and S -= W'W products are a fifth of a calibration's solve, the
+// J^T r products and the eliminations' substitutions a tenth: twice the
+// width where the processor has it, the same bits either way.
+#ifdef CDPR_AVX2_KERNELS
+namespace {
+bool use_avx2() {
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+}
+}  // namespace
+#endif
+
 void add_transposed_product(int depth, int rows, int cols, const double* x, int ldx, const double* y, int ldy,
                             double* out, int ldo, double sign, bool upper) {
 #ifdef CDPR_AVX2_KERNELS
-  // The J^T J and S -= W'W products are a fifth of a calibration's solve:
-  // twice the width where the processor has it, the same bits either way.
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  if (avx2) return avx2::add_transposed_product(depth, rows, cols, x, ldx, y, ldy, out, ldo, sign, upper);
+  if (use_avx2()) return avx2::add_transposed_product(depth, rows, cols, x, ldx, y, ldy, out, ldo, sign, upper);
 #endif
   add_transposed_product_portable(depth, rows, cols, x, ldx, y, ldy, out, ldo, sign, upper);
+}
+
+void add_transposed_times_vector(int depth, int cols, const double* x, int ldx, const double* v, double sign,
+                                 double* out) {
+#ifdef CDPR_AVX2_KERNELS
+  if (use_avx2()) return avx2::add_transposed_times_vector(depth, cols, x, ldx, v, sign, out);
+#endif
+  add_transposed_times_vector_portable(depth, cols, x, ldx, v, sign, out);
+}
+
+void solve_upper_transposed_rows(int d, const double* u, const double* inverse, int m, const double* b, double* w) {
+#ifdef CDPR_AVX2_KERNELS
+  if (use_avx2()) return avx2::solve_upper_transposed_rows(d, u, inverse, m, b, w);
+#endif
+  solve_upper_transposed_rows_portable(d, u, inverse, m, b, w);
 }
 
 void add_transposed_product_portable(int depth, int rows, int cols, const double* x, int ldx, const double* y,
@@ -136,8 +160,8 @@ void add_transposed_product_portable(int depth, int rows, int cols, const double
   if (c < cols) column_tiles<1>(depth, upper ? std::min(rows, c + 1) : rows, c, x, ldx, y, ldy, out, ldo, sign);
 }
 
-void add_transposed_times_vector(int depth, int cols, const double* x, int ldx, const double* v, double sign,
-                                 double* out) {
+void add_transposed_times_vector_portable(int depth, int cols, const double* x, int ldx, const double* v,
+                                          double sign, double* out) {
   int c = 0;
   // Eight columns at a time: four independent sums, where one alone would
   // wait on its own additions down the whole depth.
@@ -182,6 +206,13 @@ void subtract_times_vector(int rows, int cols, const double* x, int ldx, const d
 }
 
 bool all_finite(const double* v, std::size_t n) {
+#ifdef CDPR_AVX2_KERNELS
+  if (use_avx2()) return avx2::all_finite(v, n);
+#endif
+  return all_finite_portable(v, n);
+}
+
+bool all_finite_portable(const double* v, std::size_t n) {
   Pair s0 = {}, s1 = {};
   const Pair zero = {};
   std::size_t i = 0;
@@ -195,7 +226,8 @@ bool all_finite(const double* v, std::size_t n) {
   return sum[0] + sum[1] + rest == 0.0;
 }
 
-void solve_upper_transposed_rows(int d, const double* u, const double* inverse, int m, const double* b, double* w) {
+void solve_upper_transposed_rows_portable(int d, const double* u, const double* inverse, int m, const double* b,
+                                          double* w) {
   int q = 0;
   // Eight columns at a time, their four pairs in registers down all d rows.
   for (; q + 8 <= m; q += 8) {

@@ -29,6 +29,9 @@ void add_transposed_product_portable(int depth, int rows, int cols, const double
 // out[c] += sign * sum_{k < depth} x(k, c) v[k] for c < cols (x' v).
 void add_transposed_times_vector(int depth, int cols, const double* x, int ldx, const double* v, double sign,
                                  double* out);
+// ... in pairs of doubles whatever the processor (as add_transposed_product_portable).
+void add_transposed_times_vector_portable(int depth, int cols, const double* x, int ldx, const double* v,
+                                          double sign, double* out);
 
 // out[k] -= sum_{c < cols} x(k, c) v[c] for k < rows (x v).
 void subtract_times_vector(int rows, int cols, const double* x, int ldx, const double* v, double* out);
@@ -38,10 +41,15 @@ void subtract_times_vector(int rows, int cols, const double* x, int ldx, const d
 // per value, or scalar sums, cost several times more on the solver's
 // whole Jacobian buffers).
 bool all_finite(const double* v, std::size_t n);
+// ... in pairs of doubles whatever the processor (as add_transposed_product_portable).
+bool all_finite_portable(const double* v, std::size_t n);
 
 // W = U'^-1 B for the d x d upper triangular U (column-major; `inverse`:
 // the reciprocals of its diagonal) and the d x m row-major B and W (forward
 // substitution, a whole row at a time).
 void solve_upper_transposed_rows(int d, const double* u, const double* inverse, int m, const double* b, double* w);
+// ... in pairs of doubles whatever the processor (as add_transposed_product_portable).
+void solve_upper_transposed_rows_portable(int d, const double* u, const double* inverse, int m, const double* b,
+                                          double* w);
 
 }  // namespace cdpr

@@ -1,5 +1,7 @@
 #include "solver/linalg/dense_kernels_avx2.h"
 
+#include "solver/linalg/dense_kernels.h"
+
 #include <algorithm>
 #include <cstring>
 
@@ -110,6 +112,87 @@ void add_transposed_product(int depth, int rows, int cols, const double* x, int 
     case 2: return columns<2>(depth, row_end, x, ldx, y, ldy, out, ldo, sign);
     case 1: return columns<1>(depth, row_end, x, ldx, y, ldy, out, ldo, sign);
   }
+}
+
+void add_transposed_times_vector(int depth, int cols, const double* x, int ldx, const double* v, double sign,
+                                 double* out) {
+  int c = 0;
+  // Sixteen columns at a time: four independent sums, as the portable kernel's eight.
+  for (; c + 16 <= cols; c += 16) {
+    Quad s0 = {}, s1 = {}, s2 = {}, s3 = {};
+    for (int k = 0; k < depth; ++k) {
+      const double* xk = x + k * ldx + c;
+      const Quad vk = splat(v[k]);
+      s0 += load(xk) * vk;
+      s1 += load(xk + 4) * vk;
+      s2 += load(xk + 8) * vk;
+      s3 += load(xk + 12) * vk;
+    }
+    const Quad s = splat(sign);
+    store(out + c, load(out + c) + s * s0);
+    store(out + c + 4, load(out + c + 4) + s * s1);
+    store(out + c + 8, load(out + c + 8) + s * s2);
+    store(out + c + 12, load(out + c + 12) + s * s3);
+  }
+  for (; c + 4 <= cols; c += 4) {
+    Quad sum = {};
+    for (int k = 0; k < depth; ++k) sum += load(x + k * ldx + c) * splat(v[k]);
+    store(out + c, load(out + c) + splat(sign) * sum);
+  }
+  // The last three columns or fewer by the portable kernel (compiled
+  // without AVX: a call across the boundary is safe, unlike a shared inline
+  // helper).
+  if (c < cols) add_transposed_times_vector_portable(depth, cols - c, x + c, ldx, v, sign, out + c);
+}
+
+void solve_upper_transposed_rows(int d, const double* u, const double* inverse, int m, const double* b, double* w) {
+  int q = 0;
+  // Eight columns at a time, their two quads in registers down all d rows.
+  for (; q + 8 <= m; q += 8) {
+    for (int i = 0; i < d; ++i) {
+      const double* ui = u + d * i;  // column i of U: U_pi for p <= i
+      const double* bi = b + i * m + q;
+      Quad v0 = load(bi), v1 = load(bi + 4);
+      for (int p = 0; p < i; ++p) {
+        const Quad factor = splat(ui[p]);
+        const double* wp = w + p * m + q;
+        v0 -= factor * load(wp);
+        v1 -= factor * load(wp + 4);
+      }
+      const Quad scale = splat(inverse[i]);
+      double* wi = w + i * m + q;
+      store(wi, v0 * scale);
+      store(wi + 4, v1 * scale);
+    }
+  }
+  for (; q + 4 <= m; q += 4) {
+    for (int i = 0; i < d; ++i) {
+      const double* ui = u + d * i;
+      Quad v0 = load(b + i * m + q);
+      for (int p = 0; p < i; ++p) v0 -= splat(ui[p]) * load(w + p * m + q);
+      store(w + i * m + q, v0 * splat(inverse[i]));
+    }
+  }
+  for (; q < m; ++q) {
+    for (int i = 0; i < d; ++i) {
+      const double* ui = u + d * i;
+      double v = b[i * m + q];
+      for (int p = 0; p < i; ++p) v -= ui[p] * w[p * m + q];
+      w[i * m + q] = v * inverse[i];
+    }
+  }
+}
+
+bool all_finite(const double* v, std::size_t n) {
+  Quad s0 = {}, s1 = {};
+  const Quad zero = {};
+  std::size_t i = 0;
+  for (; i + 8 <= n; i += 8) {
+    s0 += load(v + i) * zero;
+    s1 += load(v + i + 4) * zero;
+  }
+  const Quad sum = s0 + s1;
+  return sum[0] + sum[1] + sum[2] + sum[3] == 0.0 && cdpr::all_finite_portable(v + i, n - i);
 }
 
 }  // namespace cdpr::avx2

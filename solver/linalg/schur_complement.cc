@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 
+#include "solver/linalg/block_copy.h"
 #include "solver/linalg/dense_kernels.h"
 #include "solver/linalg/group_kernels.h"
 
@@ -58,27 +59,6 @@ SchurComplement::BlockKernel kernel_for(int da, int db) {
     case 3: return kernel_for<3>(db);
     case 6: return kernel_for<6>(db);
     default: return add_block_any;
-  }
-}
-
-// dst(i, c) = block(i, c) for a row-major m x d block into rows of stride
-// `ld`: d fixed for the tangent sizes that occur (D > 0), so each row is a
-// few moves (a generic loop, or std::copy's memmove per row, cost several
-// times more than the values); D = 0 takes the runtime `dim`.
-template <int D>
-void copy_block_columns(int m, int dim, const double* block, double* dst, int ld) {
-  const int d = D > 0 ? D : dim;
-  for (int i = 0; i < m; ++i) {
-    for (int c = 0; c < d; ++c) dst[i * ld + c] = block[i * d + c];
-  }
-}
-void copy_block_columns(int m, int d, const double* block, double* dst, int ld) {
-  switch (d) {
-    case 1: return copy_block_columns<1>(m, d, block, dst, ld);
-    case 2: return copy_block_columns<2>(m, d, block, dst, ld);
-    case 3: return copy_block_columns<3>(m, d, block, dst, ld);
-    case 6: return copy_block_columns<6>(m, d, block, dst, ld);
-    default: return copy_block_columns<0>(m, d, block, dst, ld);
   }
 }
 
@@ -163,7 +143,8 @@ SchurComplement::SchurComplement(const BlockJacobian& jacobian, const std::vecto
 
   // The global variables each group's factors reach, and each factor's group.
   std::vector<std::vector<int>> coupled_variables(group_count);
-  std::vector<int> factor_group(nf, -1);
+  std::vector<int>& factor_group = factor_group_;
+  factor_group.assign(nf, -1);
   for (int f = 0; f < nf; ++f) {
     for (int k = 0; k < jacobian_.key_count(f); ++k) {
       const int g = group_of[jacobian_.key_variable(f, k)];
@@ -205,6 +186,7 @@ SchurComplement::SchurComplement(const BlockJacobian& jacobian, const std::vecto
   reduced_rhs_.assign(n, 0.0);
   inverse_diagonal_.assign(local_dim_, 0.0);
   reduced_inverse_diagonal_.assign(n, 0.0);
+  group_zeroed_.assign(group_count, 0);
 
   // Block operations of every factor: each pair of non-constant keys once,
   // oriented so the block lands in an upper triangle or in B.
@@ -311,14 +293,27 @@ void SchurComplement::accumulate_gathered(int slot, int f, double* gradient) {
   }
 }
 
+void SchurComplement::zero_group(int group) {
+  const Group& g = groups_[group];
+  std::fill_n(a_.data() + g.block, g.dim * g.dim, 0.0);
+  std::fill_n(b_.data() + g.coupling, g.dim * (g.coupled_end - g.coupled_begin), 0.0);
+  group_zeroed_[group] = 1;
+}
+
 void SchurComplement::accumulate(int slot, double* gradient) {
-  std::fill(a_.begin(), a_.end(), 0.0);
-  std::fill(b_.begin(), b_.end(), 0.0);
+  // A group's blocks are zeroed when its first factor comes (a problem
+  // lists a pose's factors together): they are still in cache when the
+  // factor adds into them, where zeroing all of A and B first (several
+  // times the first-level cache at a few dozen poses) would have
+  // evicted them again.
+  std::fill(group_zeroed_.begin(), group_zeroed_.end(), 0);
   std::fill(c_.begin(), c_.end(), 0.0);
   std::fill(gradient, gradient + columns(), 0.0);
   const BlockJacobian& lin = jacobian_;
   double* targets[3] = {a_.data(), b_.data(), c_.data()};
   for (int f = 0; f < lin.factor_count(); ++f) {
+    const int group = factor_group_[f];
+    if (group >= 0 && !group_zeroed_[group]) zero_group(group);
     if (plans_[f].gathered) {
       accumulate_gathered(slot, f, gradient);
       continue;
@@ -332,6 +327,9 @@ void SchurComplement::accumulate(int slot, double* gradient) {
       const double* Jb = lin.jacobian(slot, f, op.b);
       op.kernel(m, da, db, Ja, Jb, targets[op.target] + op.offset, op.stride);
     }
+  }
+  for (std::size_t g = 0; g < groups_.size(); ++g) {
+    if (!group_zeroed_[g]) zero_group(static_cast<int>(g));
   }
 }
 

@@ -147,6 +147,8 @@ class SchurComplement {
   static int runs_cost(const std::vector<ColumnRun>& runs);
   static std::vector<ColumnRun> merge_runs(std::vector<ColumnRun> runs, int local_count);
   void accumulate_gathered(int slot, int f, double* gradient);
+  // Zeroes group g's blocks of A and B (the first thing accumulate() does to them).
+  void zero_group(int g);
   // reduced_rhs_ = S^-1 reduced_rhs_ with the last factorisation of S.
   void solve_reduced();
   SchurComplement(const BlockJacobian& jacobian, const std::vector<int>& group_of, int group_count);
@@ -163,6 +165,8 @@ class SchurComplement {
   std::vector<double> inverse_diagonal_;          // per local column: 1 / U_jj of its group's factor
   std::vector<double> reduced_inverse_diagonal_;  // 1 / diagonal of S's factor
   std::vector<FactorPlan> plans_;        // per factor
+  std::vector<int> factor_group_;        // per factor: the group of its local keys, -1 for none
+  std::vector<unsigned char> group_zeroed_;  // per group: its blocks zeroed in this accumulate()
   std::vector<ColumnRun> runs_;
   std::vector<RunProduct> products_;
   std::vector<int> gather_column_;       // per factor key (the Jacobian's order): column in the gathered row, -1 if constant

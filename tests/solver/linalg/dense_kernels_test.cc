@@ -4,7 +4,9 @@
 #include "solver/linalg/dense_kernels_avx2.h"
 #endif
 
+#include <limits>
 #include <random>
+#include <vector>
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
@@ -148,6 +150,63 @@ TEST(DenseKernels, RowWiseForwardSubstitutionSolvesUTransposedW) {
       solve_upper_transposed_rows(d, u.data(), inverse.data(), m, b.data(), w.data());
       // THEN U'W = B
       EXPECT_LT((u.transpose() * w - b).cwiseAbs().maxCoeff(), 1e-12) << d << " " << m;
+    }
+  }
+}
+
+// The other two AVX2 kernels against their portable versions, bit for bit.
+TEST(DenseKernels, Avx2VectorProductAndSubstitutionGiveThePortableBits) {
+#ifndef CDPR_AVX2_KERNELS
+  GTEST_SKIP() << "not an x86-64 build";
+#else
+  if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this processor has no AVX2";
+  std::mt19937 rng(8);
+  for (int depth : {0, 1, 7, 9}) {
+    for (int cols = 1; cols <= 37; ++cols) {  // blocks of sixteen, quads and single columns
+      const RowMajor x = random_matrix(depth, cols + 1, rng);
+      const Eigen::VectorXd v = Eigen::VectorXd::Random(depth);
+      const Eigen::VectorXd start = Eigen::VectorXd::Random(cols);
+      Eigen::VectorXd portable = start, wide = start;
+      add_transposed_times_vector_portable(depth, cols, x.data(), cols + 1, v.data(), -3.0, portable.data());
+      avx2::add_transposed_times_vector(depth, cols, x.data(), cols + 1, v.data(), -3.0, wide.data());
+      for (int c = 0; c < cols; ++c) ASSERT_EQ(portable(c), wide(c)) << depth << " " << cols;
+    }
+  }
+  for (int d : {1, 2, 6, 8}) {
+    for (int m = 1; m <= 29; ++m) {
+      Eigen::MatrixXd u = Eigen::MatrixXd::Random(d, d).triangularView<Eigen::Upper>();
+      u.diagonal().array() += 3.0;
+      const Eigen::VectorXd inverse = u.diagonal().cwiseInverse();
+      const RowMajor b = random_matrix(d, m, rng);
+      RowMajor portable(d, m), wide(d, m);
+      solve_upper_transposed_rows_portable(d, u.data(), inverse.data(), m, b.data(), portable.data());
+      avx2::solve_upper_transposed_rows(d, u.data(), inverse.data(), m, b.data(), wide.data());
+      for (int i = 0; i < d; ++i) {
+        for (int q = 0; q < m; ++q) ASSERT_EQ(portable(i, q), wide(i, q)) << d << " " << m;
+      }
+    }
+  }
+#endif
+}
+
+TEST(DenseKernels, AllFiniteFindsAnInfinityOrNaNAnywhere) {
+  using Check = bool (*)(const double*, std::size_t);
+  std::vector<Check> checks = {all_finite, all_finite_portable};
+#ifdef CDPR_AVX2_KERNELS
+  if (__builtin_cpu_supports("avx2")) checks.push_back(avx2::all_finite);
+#endif
+  for (Check check : checks) {
+    for (std::size_t n = 0; n <= 21; ++n) {
+      std::vector<double> v(n, 1.5);
+      EXPECT_TRUE(check(v.data(), n)) << n;
+      for (std::size_t at = 0; at < n; ++at) {
+        for (double bad : {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                           std::numeric_limits<double>::quiet_NaN()}) {
+          v[at] = bad;
+          EXPECT_FALSE(check(v.data(), n)) << n << " " << at;
+          v[at] = 1.5;
+        }
+      }
     }
   }
 }
