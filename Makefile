@@ -15,17 +15,24 @@ comma      := ,
 export CMAKE_GENERATOR ?= Ninja
 
 # Debian packages the project needs; see README.md for why each is here.
-DEB_PACKAGES := build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev \
-                libmodbus-dev libsystemd-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev \
-                libgtest-dev libgmock-dev libbenchmark-dev libgpiod-dev systemd ninja-build \
-                mbpoll libseccomp-dev bubblewrap lintian chromium tidy
+# BUILD_PACKAGES configure and build the tree (tests/sandbox's configure
+# needs libseccomp-dev and systemd-analyze); TEST_PACKAGES are what only
+# running the tests needs. `make`, `make demo` and `make demo-offline`
+# install the first alone: chromium and lintian bring hundreds of
+# megabytes the demo does not run.
+BUILD_PACKAGES := build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev \
+                  libmodbus-dev libsystemd-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev \
+                  libgtest-dev libgmock-dev libgpiod-dev systemd ninja-build libseccomp-dev
+TEST_PACKAGES  := mbpoll bubblewrap lintian chromium tidy
+DEB_PACKAGES   := $(BUILD_PACKAGES) $(TEST_PACKAGES)
 # mbpoll: a Modbus master neither the daemon nor the virtual robot shares
-# code with, for the load cell's cross-check test. libseccomp-dev and
-# bubblewrap: the test that runs the daemon in the unit's sandbox. lintian:
-# the package test. chromium and tidy: the tests that read the HTML reports
-# in a headless browser and check them as HTML5 (tools/check-report).
-# Ceres is used by the benchmark comparison only, never linked into the daemon.
-BENCH_PACKAGES := libceres-dev
+# code with, for the load cell's cross-check test. bubblewrap: the test that
+# runs the daemon in the unit's sandbox. lintian: the package test. chromium
+# and tidy: the tests that read the HTML reports in a headless browser and
+# check them as HTML5 (tools/check-report).
+# Ceres and Google Benchmark are used by the benchmark comparison only,
+# never linked into the daemon.
+BENCH_PACKAGES := libceres-dev libbenchmark-dev
 # clang and its runtimes (libFuzzer, ASan, UBSan) for make fuzz only.
 FUZZ_PACKAGES := clang libclang-rt-14-dev
 
@@ -33,7 +40,7 @@ FUZZ_BUILD   ?= $(BUILD)-fuzz
 FUZZ_SECONDS ?= 600
 FUZZ_TARGETS ?=
 
-.PHONY: all deps bench-deps configure check test sanitize fuzz demo demo-offline bench install deb clean
+.PHONY: all deps build-deps bench-deps configure check test sanitize fuzz demo demo-offline bench install deb clean
 
 all: configure
 	cmake --build $(BUILD) -j $(JOBS)
@@ -41,22 +48,25 @@ all: configure
 deps:
 	@./tools/install-deps.sh $(DEB_PACKAGES)
 
+build-deps:
+	@./tools/install-deps.sh $(BUILD_PACKAGES)
+
 bench-deps:
 	@./tools/install-deps.sh $(BENCH_PACKAGES)
 
 $(BUILD)/CMakeCache.txt:
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DCDPR_WERROR=ON
 
-configure: deps $(BUILD)/CMakeCache.txt
+configure: build-deps $(BUILD)/CMakeCache.txt
 
 # The day-to-day loop: builds what the unit tests run, runs the tests
 # labelled unit (cmake/CdprTesting.cmake), seconds after the build.
-check: configure
+check: deps configure
 	cmake --build $(BUILD) -j $(JOBS) --target unit_test_binaries
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -L '^unit$$'
 
 # Every test: unit, integration and slow.
-test: all
+test: deps all
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
 # The whole test suite under AddressSanitizer and UndefinedBehaviorSanitizer
