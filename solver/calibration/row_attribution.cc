@@ -157,47 +157,76 @@ double refit_without(const Problem& full, LocalProblem& local, const std::vector
   return chi2;
 }
 
+// Two readings are told apart when leaving out one explains the rest of
+// the row better than leaving out the other by more than the chi-square(1)
+// quantile at 1e-3: the likelihood ratio of "this one is wrong" against
+// "that one is" is then above exp(10.83 / 2) = 225. Below it, which of them
+// is wrong is left open.
+constexpr double kAmbiguousChi2 = 10.83;
+
 }  // namespace
 
 std::vector<SensorReading> attribute_row(const Problem& problem, int row_id, int pose_index,
                                          const std::vector<int>& row_factors, const std::vector<RowReading>& readings,
                                          double threshold_sigma) {
-  // Greedy: leave out the reading whose removal explains the row best, and
-  // another while a reading still stands out (a row may hold two gross
-  // errors, e.g. a slipped cable and a load-cell spike); at least one
-  // reading always stays in.
+  // Greedy: leave out the reading whose removal explains the row best, with
+  // every reading the data cannot tell from it (its own removal explains the
+  // row nearly as well: kAmbiguousChi2 below), and another round while a
+  // reading still stands out (a row may hold two gross errors, e.g. a
+  // slipped cable and a load-cell spike); at least one reading always stays in.
+  const std::size_t n = readings.size();
   std::vector<int> left_out;  // indices into readings
-  std::vector<double> residuals(readings.size(), 0.0);
-  while (left_out.size() + 1 < readings.size()) {
-    double best_chi2 = std::numeric_limits<double>::infinity();
+  std::vector<double> residuals(n, 0.0);  // in the refit without those left out
+  std::vector<int> groups(n, 0);
+  int group_count = 0;
+  auto is_out = [&](std::size_t j) {
+    return std::find(left_out.begin(), left_out.end(), static_cast<int>(j)) != left_out.end();
+  };
+  // The refit without the readings left out and `extra` (-1: none): the
+  // rest's chi-square, and each reading's normalised residual in it.
+  auto refit = [&](int extra, std::vector<double>& normalised) {
+    LeftOut pairs;
+    for (int o : left_out) pairs.emplace_back(readings[o].factor, readings[o].residual_row);
+    if (extra >= 0) pairs.emplace_back(readings[extra].factor, readings[extra].residual_row);
+    LocalProblem local = local_problem(problem, row_factors, pose_index);
+    const double chi2 = refit_without(problem, local, row_factors, pairs);
+    normalised.assign(n, 0.0);
+    for (std::size_t r = 0; r < n; ++r) {
+      normalised[r] = row_residual(problem, local, readings[r].factor, readings[r].residual_row) / readings[r].spread;
+    }
+    return chi2;
+  };
+  while (left_out.size() + 1 < n) {
+    std::vector<double> chi2(n, std::numeric_limits<double>::infinity());
     int best = -1;
-    for (std::size_t j = 0; j < readings.size(); ++j) {
-      if (std::find(left_out.begin(), left_out.end(), static_cast<int>(j)) != left_out.end()) continue;
-      LeftOut pairs;
-      for (int o : left_out) pairs.emplace_back(readings[o].factor, readings[o].residual_row);
-      pairs.emplace_back(readings[j].factor, readings[j].residual_row);
-      LocalProblem local = local_problem(problem, row_factors, pose_index);
-      const double chi2 = refit_without(problem, local, row_factors, pairs);
-      if (!(chi2 < best_chi2)) continue;
-      best_chi2 = chi2;
-      best = static_cast<int>(j);
-      for (std::size_t r = 0; r < readings.size(); ++r) {
-        residuals[r] = row_residual(problem, local, readings[r].factor, readings[r].residual_row) / readings[r].spread;
-      }
+    for (std::size_t j = 0; j < n; ++j) {
+      if (is_out(j)) continue;
+      chi2[j] = refit(static_cast<int>(j), residuals);
+      if (chi2[j] < (best < 0 ? std::numeric_limits<double>::infinity() : chi2[best])) best = static_cast<int>(j);
     }
     if (best < 0) break;
-    left_out.push_back(best);
+    // The readings whose removal explains the rest within kAmbiguousChi2 of
+    // the best: the data cannot tell which of them is wrong, so all go.
+    std::vector<int> group{best};
+    for (std::size_t j = 0; j < n; ++j) {
+      if (static_cast<int>(j) == best || !(chi2[j] - chi2[best] < kAmbiguousChi2)) continue;
+      if (left_out.size() + group.size() + 1 >= n) break;
+      group.push_back(static_cast<int>(j));
+    }
+    const int group_id = group.size() > 1 ? ++group_count : 0;
+    for (int j : group) {
+      left_out.push_back(j);
+      groups[j] = group_id;
+    }
     // The row's pose can absorb a second gross error into its prior, leaving
     // every remaining reading small but the rest's chi-square far above it.
-    bool another = best_chi2 > threshold_sigma * threshold_sigma;
-    for (std::size_t r = 0; r < readings.size(); ++r) {
-      const bool out = std::find(left_out.begin(), left_out.end(), static_cast<int>(r)) != left_out.end();
-      another = another || (!out && std::abs(residuals[r]) > threshold_sigma);
-    }
+    const double rest = refit(-1, residuals);
+    bool another = rest > threshold_sigma * threshold_sigma;
+    for (std::size_t r = 0; r < n; ++r) another = another || (!is_out(r) && std::abs(residuals[r]) > threshold_sigma);
     if (!another) break;
   }
   std::vector<SensorReading> out;
-  for (int j : left_out) out.push_back({row_id, readings[j].sensor, readings[j].cable, residuals[j]});
+  for (int j : left_out) out.push_back({row_id, readings[j].sensor, readings[j].cable, residuals[j], groups[j]});
   return out;
 }
 

@@ -6,10 +6,15 @@
 // Leave-one-out decides instead: the row's pose and force are refitted
 // (Levenberg-Marquardt, everything global held) without each of its readings in
 // turn; the reading whose removal leaves the smallest chi-square of the
-// rest is the gross error, its residual that refit's prediction minus the
-// reading. While another reading still stands out in that refit, the one
-// whose removal (with the first) explains the rest best is left out too,
-// and so while the rest's chi-square stays above the threshold squared.
+// rest is the gross error. Each reading left out carries its residual in
+// the last refit (without every reading left out): its prediction minus the
+// reading. When another reading's removal explains the rest nearly as
+// well (its chi-square within the chi-square(1) quantile at 1e-3, 10.83, of
+// the best), the data cannot tell which of them is wrong: all such readings
+// are left out as one suspect group (SensorReading::group). While another
+// reading still stands out in the refit without them, the reading (or group) whose removal explains the
+// rest best is left out too, and so while the rest's chi-square stays above
+// the threshold squared.
 
 #include <vector>
 
