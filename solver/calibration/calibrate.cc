@@ -409,6 +409,8 @@ CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& sampl
     // The set the kept fit left out gets its swap test once, at the end.
     result = swap_within_rows(robot, samples, options, best_of_starts(robot, samples, options, std::move(result)));
   }
+  settle_groups(result.gross_errors);
+  settle_groups(result.calibration.rejected);
   // Once, on the fit kept: the choice among fits above is by the chi-square test alone.
   test_missing_terms(robot, options, result);
   return result;

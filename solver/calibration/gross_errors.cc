@@ -47,6 +47,16 @@ double largest_normalised_residual(const std::vector<ReadingResidual>& residuals
   return largest;
 }
 
+void settle_groups(std::vector<SensorReading>& readings) {
+  for (SensorReading& r : readings) {
+    if (r.group == 0) continue;
+    const auto members = std::count_if(readings.begin(), readings.end(), [&](const SensorReading& o) {
+      return o.row == r.row && o.group == r.group;
+    });
+    if (members < 2) r.group = 0;
+  }
+}
+
 std::vector<SensorReading> confirm_left_out(const std::vector<SensorReading>& candidates,
                                             const std::vector<SensorReading>& predicted, bool refit_ok,
                                             double bar_sigma) {
@@ -57,8 +67,25 @@ std::vector<SensorReading> confirm_left_out(const std::vector<SensorReading>& ca
     });
     return p != predicted.end() && std::isfinite(p->value) ? &*p : nullptr;
   };
+  // A reading stays out on its own evidence: predicted beyond the bar, or
+  // flagged with no prediction to test.
+  auto stays_out = [&](const SensorReading& r) {
+    const SensorReading* p = prediction(r);
+    return p ? std::abs(p->value) > bar_sigma : std::isfinite(r.value);
+  };
   std::vector<SensorReading> confirmed;
   for (const SensorReading& r : candidates) {
+    if (r.group != 0) {
+      // A suspect group stays out whole while any member does: the data
+      // could not tell which of them is wrong, and with all of them out the
+      // row's pose is fitted to the rest alone, so a member predicted within
+      // the bar is no evidence that it is the good one.
+      const bool group_out = std::any_of(candidates.begin(), candidates.end(), [&](const SensorReading& o) {
+        return o.row == r.row && o.group == r.group && stays_out(o);
+      });
+      if (group_out) confirmed.push_back(r);
+      continue;
+    }
     const SensorReading* p = prediction(r);
     if (!p) {
       if (std::isfinite(r.value)) confirmed.push_back(r);

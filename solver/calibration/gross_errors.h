@@ -44,6 +44,11 @@ std::vector<SensorReading> gross_errors(const std::vector<ReadingResidual>& resi
 // The largest normalised residual (0 when there are none).
 double largest_normalised_residual(const std::vector<ReadingResidual>& residuals);
 
+// Clears the group of a reading left alone in its suspect group
+// (SensorReading::group): a later change of the set left out (the swap test)
+// may have taken the others back in, and a group of one is a reading named alone.
+void settle_groups(std::vector<SensorReading>& readings);
+
 // The final test of the readings a fit left out: `candidates` (their value
 // the normalised residual that flagged them, NaN for a reading left out only
 // because its whole row was a hypothesis) against `predicted`, each as the
@@ -54,7 +59,8 @@ double largest_normalised_residual(const std::vector<ReadingResidual>& residuals
 // hypothesis row (all its readings left out, so each is predicted from the
 // row's pose prior alone) only the reading predicted farthest off stays
 // out. A hypothesis reading nothing confirms goes back in, so no NaN is
-// ever reported.
+// ever reported. A suspect group (SensorReading::group) stays out whole
+// while any of its members stays out by the rules above.
 std::vector<SensorReading> confirm_left_out(const std::vector<SensorReading>& candidates,
                                             const std::vector<SensorReading>& predicted, bool refit_ok,
                                             double bar_sigma);

@@ -157,47 +157,122 @@ double refit_without(const Problem& full, LocalProblem& local, const std::vector
   return chi2;
 }
 
+// Two choices of readings to leave out are told apart when one explains
+// the rest of the row better than the other by more than the chi-square(1)
+// quantile at 1e-3: the likelihood ratio of "these are wrong" against
+// "those are" is then above exp(10.83 / 2) = 225. Below it, which of them
+// is wrong is left open.
+constexpr double kAmbiguousChi2 = 10.83;
+
 }  // namespace
 
 std::vector<SensorReading> attribute_row(const Problem& problem, int row_id, int pose_index,
                                          const std::vector<int>& row_factors, const std::vector<RowReading>& readings,
                                          double threshold_sigma) {
-  // Greedy: leave out the reading whose removal explains the row best, and
-  // another while a reading still stands out (a row may hold two gross
-  // errors, e.g. a slipped cable and a load-cell spike); at least one
-  // reading always stays in.
+  const std::size_t n = readings.size();
   std::vector<int> left_out;  // indices into readings
-  std::vector<double> residuals(readings.size(), 0.0);
-  while (left_out.size() + 1 < readings.size()) {
-    double best_chi2 = std::numeric_limits<double>::infinity();
-    int best = -1;
-    for (std::size_t j = 0; j < readings.size(); ++j) {
-      if (std::find(left_out.begin(), left_out.end(), static_cast<int>(j)) != left_out.end()) continue;
-      LeftOut pairs;
-      for (int o : left_out) pairs.emplace_back(readings[o].factor, readings[o].residual_row);
-      pairs.emplace_back(readings[j].factor, readings[j].residual_row);
-      LocalProblem local = local_problem(problem, row_factors, pose_index);
-      const double chi2 = refit_without(problem, local, row_factors, pairs);
-      if (!(chi2 < best_chi2)) continue;
-      best_chi2 = chi2;
-      best = static_cast<int>(j);
-      for (std::size_t r = 0; r < readings.size(); ++r) {
-        residuals[r] = row_residual(problem, local, readings[r].factor, readings[r].residual_row) / readings[r].spread;
+  std::vector<int> groups(n, 0);
+  int group_count = 0;
+  auto is_out = [&](int j) { return std::find(left_out.begin(), left_out.end(), j) != left_out.end(); };
+  // One choice of readings to leave out beside `left_out`: the rest's
+  // chi-square, each reading's normalised residual in that refit, and
+  // whether the rest is explained (no reading left in beyond the threshold,
+  // the chi-square within the threshold squared: the row's pose can absorb
+  // a gross error into its prior, leaving every reading small but the
+  // chi-square far above it).
+  struct Choice {
+    std::vector<int> out;
+    double chi2 = std::numeric_limits<double>::infinity();
+    std::vector<double> residuals;
+    bool explained = false;
+  };
+  auto refit = [&](std::vector<int> out) {
+    Choice c;
+    c.out = std::move(out);
+    LeftOut pairs;
+    for (int o : left_out) pairs.emplace_back(readings[o].factor, readings[o].residual_row);
+    for (int o : c.out) pairs.emplace_back(readings[o].factor, readings[o].residual_row);
+    LocalProblem local = local_problem(problem, row_factors, pose_index);
+    c.chi2 = refit_without(problem, local, row_factors, pairs);
+    c.residuals.assign(n, 0.0);
+    c.explained = c.chi2 <= threshold_sigma * threshold_sigma;
+    for (std::size_t r = 0; r < n; ++r) {
+      c.residuals[r] = row_residual(problem, local, readings[r].factor, readings[r].residual_row) / readings[r].spread;
+      const bool out_now = is_out(static_cast<int>(r)) ||
+                           std::find(c.out.begin(), c.out.end(), static_cast<int>(r)) != c.out.end();
+      if (!out_now && std::abs(c.residuals[r]) > threshold_sigma) c.explained = false;
+    }
+    return c;
+  };
+  // Every choice of `size` readings not yet out, each refitted.
+  auto choices = [&](std::size_t size) {
+    std::vector<Choice> all;
+    for (std::size_t a = 0; a < n; ++a) {
+      if (is_out(static_cast<int>(a))) continue;
+      if (size == 1) {
+        all.push_back(refit({static_cast<int>(a)}));
+        continue;
+      }
+      for (std::size_t b = a + 1; b < n; ++b) {
+        if (!is_out(static_cast<int>(b))) all.push_back(refit({static_cast<int>(a), static_cast<int>(b)}));
       }
     }
-    if (best < 0) break;
-    left_out.push_back(best);
-    // The row's pose can absorb a second gross error into its prior, leaving
-    // every remaining reading small but the rest's chi-square far above it.
-    bool another = best_chi2 > threshold_sigma * threshold_sigma;
-    for (std::size_t r = 0; r < readings.size(); ++r) {
-      const bool out = std::find(left_out.begin(), left_out.end(), static_cast<int>(r)) != left_out.end();
-      another = another || (!out && std::abs(residuals[r]) > threshold_sigma);
+    return all;
+  };
+  // Leaves out the best of `all` (of those that explain the row when
+  // `only_explained`) and every reading of the choices the data cannot tell
+  // from it (kAmbiguousChi2): readings in all of those choices
+  // are named alone, the others as one suspect group; at least one reading
+  // stays in. Returns the refit without everything now left out.
+  auto take = [&](const std::vector<Choice>& all, bool only_explained) {
+    const Choice* best = nullptr;
+    for (const Choice& c : all) {
+      if ((c.explained || !only_explained) && (!best || c.chi2 < best->chi2)) best = &c;
     }
-    if (!another) break;
+    std::vector<int> common = best->out, either;
+    for (const Choice& c : all) {
+      if (!(c.chi2 - best->chi2 < kAmbiguousChi2)) continue;
+      for (int j : c.out) {
+        if (std::find(either.begin(), either.end(), j) == either.end()) either.push_back(j);
+      }
+      std::erase_if(common, [&](int j) { return std::find(c.out.begin(), c.out.end(), j) == c.out.end(); });
+    }
+    const int group_id = common.size() < either.size() ? ++group_count : 0;
+    // The best choice's own readings first, so a cut keeps them.
+    std::stable_partition(either.begin(), either.end(), [&](int j) {
+      return std::find(best->out.begin(), best->out.end(), j) != best->out.end();
+    });
+    for (int j : either) {
+      if (left_out.size() + 1 >= n) break;
+      left_out.push_back(j);
+      groups[j] = std::find(common.begin(), common.end(), j) != common.end() ? 0 : group_id;
+    }
+    return refit({});
+  };
+  // The fewest readings that explain the row: each single reading, then
+  // each pair, left out (a pair found together is not masked by a first
+  // choice that was wrong: a slipped cable and a load-cell spike in one row
+  // can make a third reading's removal look best); beyond two, greedily,
+  // one reading (or group) more per round while the rest is not explained.
+  Choice now;
+  for (std::size_t size = 1; size <= 2 && left_out.size() + size < n; ++size) {
+    std::vector<Choice> all = choices(size);
+    if (all.empty()) break;
+    const bool any = std::any_of(all.begin(), all.end(), [](const Choice& c) { return c.explained; });
+    const bool last = size == 2 || left_out.size() + size + 1 >= n;
+    if (!any && !last) continue;
+    // The best choice that explains the row (when none does, the best of
+    // all, and the greedy rounds below go on); every choice is its rival.
+    now = take(all, any);
+    break;
+  }
+  while (!now.explained && left_out.size() + 1 < n && !now.residuals.empty()) {
+    std::vector<Choice> all = choices(1);
+    if (all.empty()) break;
+    now = take(all, false);
   }
   std::vector<SensorReading> out;
-  for (int j : left_out) out.push_back({row_id, readings[j].sensor, readings[j].cable, residuals[j]});
+  for (int j : left_out) out.push_back({row_id, readings[j].sensor, readings[j].cable, now.residuals[j], groups[j]});
   return out;
 }
 

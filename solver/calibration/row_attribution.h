@@ -6,10 +6,18 @@
 // Leave-one-out decides instead: the row's pose and force are refitted
 // (Levenberg-Marquardt, everything global held) without each of its readings in
 // turn; the reading whose removal leaves the smallest chi-square of the
-// rest is the gross error, its residual that refit's prediction minus the
-// reading. While another reading still stands out in that refit, the one
-// whose removal (with the first) explains the rest best is left out too,
-// and so while the rest's chi-square stays above the threshold squared.
+// rest, and leaves it explained (no reading beyond the threshold, the
+// chi-square within the threshold squared), is the gross error. When no
+// single reading explains the row, each pair is tried (a row may hold two
+// gross errors, e.g. a slipped cable and a load-cell spike, and the single
+// removal that looks best may be neither), and beyond a pair one reading
+// more per round while the rest is not explained. When another choice
+// explains the rest nearly as well (its chi-square within the chi-square(1)
+// quantile at 1e-3, 10.83, of the best), the data cannot tell which is
+// wrong: readings in every such choice are named alone, the others as one
+// suspect group (SensorReading::group), all left out. Each reading left out
+// carries its residual in the refit without all of them: its prediction
+// minus the reading.
 
 #include <vector>
 

@@ -38,6 +38,10 @@ struct SensorReading {
   SensorKind sensor = SensorKind::kEncoder;
   int cable = 0;      // encoder: its cable; force: the reference cable
   double value = 0.0; // rejected: normalised residual [sigma]; planted: error [m or N]
+  // rejected: 0 when the reading was named alone; otherwise the readings of
+  // its row with the same group number are one suspect group: the row holds
+  // a gross error the data cannot pin on one of them, so all were left out.
+  int group = 0;
 };
 inline const char* sensor_name(SensorKind kind) { return kind == SensorKind::kEncoder ? "encoder" : "force"; }
 

@@ -14,7 +14,8 @@ std::vector<SensorReading> read_sensor_readings(TomlReader& reader, const toml::
                       {{"row", Presence::kRequired},
                        {"sensor", Presence::kRequired},
                        {"cable", Presence::kRequired},
-                       {value_key, Presence::kRequired}});
+                       {value_key, Presence::kRequired},
+                       {"group", Presence::kOptional}});
     SensorReading& reading = readings.emplace_back();
     reading.row = reader.count(*table, "row", path);
     const std::string sensor = reader.string(*table, "sensor", path);
@@ -25,6 +26,7 @@ std::vector<SensorReading> read_sensor_readings(TomlReader& reader, const toml::
     reading.sensor = sensor == "force" ? SensorKind::kForce : SensorKind::kEncoder;
     reading.cable = reader.count(*table, "cable", path);
     reading.value = reader.number(*table, value_key, path);
+    if (table->contains("group")) reading.group = reader.count(*table, "group", path);
   }
   return readings;
 }
@@ -37,6 +39,9 @@ void append_sensor_readings(std::string& out, const std::vector<SensorReading>& 
     append_line(out, "sensor = " + toml_string(sensor_name(reading.sensor)));
     append_line(out, "cable = " + std::to_string(reading.cable));
     append_line(out, std::string(value_key) + " = " + toml_number(reading.value), std::string(value_comment));
+    if (reading.group != 0) {
+      append_line(out, "group = " + std::to_string(reading.group), "suspect group within its row: one of them is wrong");
+    }
   }
 }
 

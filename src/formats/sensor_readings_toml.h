@@ -3,7 +3,8 @@
 // [[rejected]] (readings a calibration refused as gross errors, `residual`
 // in sigmas) and truth.toml's [[outlier]] (readings a simulator made wrong
 // on purpose, `error` in m or N). Each table: row (sample id), sensor
-// ("encoder" or "force"), cable, and the value key.
+// ("encoder" or "force"), cable, the value key, and an optional `group`
+// (SensorReading::group; absent when 0, so files without it still read).
 
 #include <string>
 #include <string_view>

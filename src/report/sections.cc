@@ -122,6 +122,17 @@ std::string anchors_shift_text(const Calibration& from, const Calibration& to) {
   return "largest " + length_text(largest) + format(" (anchor %d, %.1f sigma)", which, in_sigma);
 }
 
+std::string suspect_group_text(const std::vector<SensorReading>& rejected, const SensorReading& reading) {
+  if (reading.group == 0) return {};
+  std::string text;
+  for (const SensorReading& r : rejected) {
+    if (r.row != reading.row || r.group != reading.group) continue;
+    text += (text.empty() ? "" : " or ") + std::string(sensor_name(r.sensor)) +
+            (r.sensor == SensorKind::kEncoder ? format(" cable %d", r.cable) : "");
+  }
+  return text;
+}
+
 std::string rejected_text(const std::vector<SensorReading>& rejected, int shown) {
   if (rejected.empty()) return "none";
   std::string text = format("%zu: ", rejected.size());
@@ -129,18 +140,24 @@ std::string rejected_text(const std::vector<SensorReading>& rejected, int shown)
     const SensorReading& r = rejected[k];
     text += format("%srow %d %s%s %+.1f sigma", k ? "; " : "", r.row, sensor_name(r.sensor),
                    r.sensor == SensorKind::kEncoder ? format(" cable %d", r.cable).c_str() : "", r.value);
+    if (r.group != 0) text += " (suspect group: " + suspect_group_text(rejected, r) + ")";
   }
   if (static_cast<int>(rejected.size()) > shown) text += format("; and %zu more", rejected.size() - shown);
   return text;
 }
 
 std::string rejected_table(const std::vector<SensorReading>& rejected) {
+  const bool groups =
+      std::any_of(rejected.begin(), rejected.end(), [](const SensorReading& r) { return r.group != 0; });
   std::vector<std::vector<std::string>> rows;
   for (const SensorReading& r : rejected) {
     rows.push_back({std::to_string(r.row), sensor_name(r.sensor),
                     r.sensor == SensorKind::kEncoder ? std::to_string(r.cable) : "-", format("%+.1f", r.value)});
+    if (groups) rows.back().push_back(r.group != 0 ? suspect_group_text(rejected, r) : "-");
   }
-  return table({"row (samples.csv id)", "sensor", "cable", "residual [sigma]"}, rows);
+  std::vector<std::string> header{"row (samples.csv id)", "sensor", "cable", "residual [sigma]"};
+  if (groups) header.push_back("suspect group (one of them is wrong)");
+  return table(header, rows);
 }
 
 std::string residual_plots(const std::vector<Evaluation>& evaluations) {

@@ -26,10 +26,15 @@ std::string anchors_moved_text(const Robot& nominal, const Calibration& calibrat
 // The largest distance between the anchors of two fits, in their sigmas:
 // "largest 12.3 mm (anchor 1, 4.1 sigma)".
 std::string anchors_shift_text(const Calibration& from, const Calibration& to);
+// The suspect group `reading` belongs to (SensorReading::group), its
+// members in `rejected` order: "encoder 2 or force"; "" when it was named alone.
+std::string suspect_group_text(const std::vector<SensorReading>& rejected, const SensorReading& reading);
 // Readings left out as gross errors, at most `shown` of them: "row 12
-// encoder cable 2 +8.1 sigma; row 30 force +6.0 sigma"; "none".
+// encoder cable 2 +8.1 sigma; row 30 force +6.0 sigma (suspect group:
+// force or encoder cable 3)"; "none".
 std::string rejected_text(const std::vector<SensorReading>& rejected, int shown = 4);
-// Every rejected reading as a table: row, sensor, cable, residual in sigmas.
+// Every rejected reading as a table: row, sensor, cable, residual in sigmas,
+// and a suspect-group column when any reading is in one.
 std::string rejected_table(const std::vector<SensorReading>& rejected);
 
 // Residual scatter plots: one row per (sensor, quantity) with one plot per

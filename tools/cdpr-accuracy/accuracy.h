@@ -50,6 +50,7 @@ struct RunResult {
   // them were rejected, and clean rows (no planted error) rejected.
   int planted_encoder = 0, recalled_encoder = 0, planted_force = 0, recalled_force = 0;
   int clean_rows = 0, clean_rows_rejected = 0;
+  std::vector<std::string> missed;   // each planted reading not reported, and why
   bool misfit = false;               // the model-fit test flagged the fit
   bool refused = false;              // refused for too many gross errors
   double chi_square_ratio = 0.0;     // chi2 / dof of the final fit
@@ -75,6 +76,7 @@ struct Summary {
   double mean_iterations = 0.0;
   int planted_encoder = 0, recalled_encoder = 0, planted_force = 0, recalled_force = 0;
   int clean_rows = 0, clean_rows_rejected = 0;
+  std::vector<std::string> missed;   // each planted reading not reported, and why
   int misfits = 0;
   int refusals = 0;
   int truth_start_mismatches = 0;  // |cost gap| > 1e-6 or one of the two fits failed

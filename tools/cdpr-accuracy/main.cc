@@ -254,6 +254,7 @@ int main(int argc, char** argv) {
                     r.offset_error_m, r.iterations, r.clean_rows_rejected, r.recalled_encoder + r.recalled_force,
                     r.planted_encoder + r.planted_force, r.misfit ? " MISFIT" : "", r.chi_square_ratio, r.truth_start_cost_gap,
                     r.ok ? "" : r.message.c_str());
+        for (const std::string& m : r.missed) std::printf("  missed %s\n", m.c_str());
       } else {
         std::fprintf(stderr, "\r%s model: run %d/%d", kind == cdpr::CableModelKind::kRigid ? "rigid" : "catenary",
                      s + 1, seeds);

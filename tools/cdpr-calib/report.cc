@@ -4,6 +4,8 @@
 #include <cmath>
 #include <ctime>
 
+#include "src/report/sections.h"
+
 namespace cdpr::tools {
 
 void print_iteration(std::FILE* out, const IterationSummary& it) {
@@ -65,7 +67,13 @@ void print_gross_errors(std::FILE* out, const std::vector<SensorReading>& reject
     std::fprintf(out, "  row %4d  %-7s", r.row, sensor_name(r.sensor));
     if (r.sensor == SensorKind::kEncoder) std::fprintf(out, " cable %d", r.cable);
     else std::fprintf(out, "        ");
-    std::fprintf(out, "  %+8.1f sigma\n", r.value);
+    std::fprintf(out, "  %+8.1f sigma", r.value);
+    if (r.group != 0) std::fprintf(out, "  suspect group: %s", report::suspect_group_text(rejected, r).c_str());
+    std::fprintf(out, "\n");
+  }
+  if (std::any_of(rejected.begin(), rejected.end(), [](const SensorReading& r) { return r.group != 0; })) {
+    std::fprintf(out, "  (a suspect group: its row holds a gross error the data cannot pin on one of its readings; "
+                      "all of them were left out)\n");
   }
 }
 
@@ -113,12 +121,15 @@ void print_outlier_recall(std::FILE* out, const std::vector<SensorReading>& reje
   if (planted.empty() && rejected.empty()) return;
   int found = 0;
   for (const SensorReading& p : planted) {
-    const bool hit = std::any_of(rejected.begin(), rejected.end(), [&](const SensorReading& r) {
+    const auto named = std::find_if(rejected.begin(), rejected.end(), [&](const SensorReading& r) {
       return r.row == p.row && r.sensor == p.sensor && (r.sensor == SensorKind::kForce || r.cable == p.cable);
     });
+    const bool hit = named != rejected.end();
     found += hit;
-    std::fprintf(out, "planted %-7s row %4d cable %d error %+.3g: %s\n", sensor_name(p.sensor), p.row, p.cable,
-                 p.value, hit ? "rejected" : "NOT rejected");
+    const std::string group =
+        named != rejected.end() && named->group != 0 ? " (suspect group: " + report::suspect_group_text(rejected, *named) + ")" : "";
+    std::fprintf(out, "planted %-7s row %4d cable %d error %+.3g: %s%s\n", sensor_name(p.sensor), p.row, p.cable,
+                 p.value, hit ? "rejected" : "NOT rejected", group.c_str());
   }
   std::fprintf(out, "planted gross errors rejected: %d of %zu; rejected readings: %zu\n", found, planted.size(),
                rejected.size());

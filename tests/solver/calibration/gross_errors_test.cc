@@ -94,5 +94,40 @@ TEST(GrossErrors, OfAHypothesisRowOnlyTheReadingPredictedFarthestOffStaysOut) {
   EXPECT_DOUBLE_EQ(confirmed[0].value, 25.0);
 }
 
+TEST(GrossErrors, ASuspectGroupStaysOutWholeWhileOneOfItsMembersDoes) {
+  // GIVEN a row's suspect group (encoder 3 or the load cell) and another
+  // row's group, of which the refit predicts only one member beyond the bar
+  const std::vector<SensorReading> candidates{{6, SensorKind::kForce, 0, -22.9, 1},
+                                              {6, SensorKind::kEncoder, 3, 5.9, 1},
+                                              {9, SensorKind::kForce, 0, 7.0, 1},
+                                              {9, SensorKind::kEncoder, 1, 6.0, 1}};
+  const std::vector<SensorReading> predicted{{6, SensorKind::kForce, 0, -22.9},
+                                             {6, SensorKind::kEncoder, 3, 1.2},
+                                             {9, SensorKind::kForce, 0, 2.0},
+                                             {9, SensorKind::kEncoder, 1, -3.0}};
+  // WHEN confirmed at 5 sigma
+  const std::vector<SensorReading> confirmed = confirm_left_out(candidates, predicted, true, 5.0);
+  // THEN row 6's group stays out with both members (the one predicted
+  // within the bar too), and row 9's, none of whose members is, goes back in
+  ASSERT_EQ(confirmed.size(), 2u);
+  EXPECT_EQ(confirmed[0].row, 6);
+  EXPECT_EQ(confirmed[1].row, 6);
+  EXPECT_EQ(confirmed[1].sensor, SensorKind::kEncoder);
+  EXPECT_EQ(confirmed[1].group, 1);
+}
+
+TEST(GrossErrors, AGroupOfOneIsAReadingNamedAlone) {
+  // GIVEN a group whose other member was taken back in, and a whole group
+  std::vector<SensorReading> readings{{4, SensorKind::kForce, 0, 9.0, 1},
+                                      {7, SensorKind::kEncoder, 0, 8.0, 1},
+                                      {7, SensorKind::kEncoder, 2, 7.0, 1}};
+  // WHEN settled
+  settle_groups(readings);
+  // THEN only the whole group keeps its number
+  EXPECT_EQ(readings[0].group, 0);
+  EXPECT_EQ(readings[1].group, 1);
+  EXPECT_EQ(readings[2].group, 1);
+}
+
 }  // namespace
 }  // namespace cdpr

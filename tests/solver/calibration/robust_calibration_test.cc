@@ -226,6 +226,33 @@ TEST(RobustCalibration, ARowWithAnEncoderErrorAndALoadCellSpikeLosesBoth) {
   expect_planted_named_without_misfit(config, 0.2);
 }
 
+TEST(RobustCalibration, AReadingTheDataCannotTellFromAnotherIsNamedWithItAsASuspectGroup) {
+  // GIVEN 35 poses of the large robot, nominal anchors 10 m off, where row 6
+  // holds a -0.67 m error on encoder 0 and a +116 N load-cell spike: with
+  // encoder 0 left out, leaving out encoder 3 explains the rest of the row
+  // about as well as leaving out the load cell (chi-square 2.7 against 4.4)
+  const sim::SimulatedDataset data = simulate(with_gross_errors(large(35, 48)));
+  const auto spike = std::find_if(data.truth.outliers.begin(), data.truth.outliers.end(),
+                                  [](const SensorReading& p) { return p.row == 6 && p.sensor == SensorKind::kForce; });
+  ASSERT_NE(spike, data.truth.outliers.end());
+  // WHEN calibrated with default options
+  const CalibrationResult result = calibrate(data.nominal, data.samples, CalibrationOptions{});
+  ASSERT_TRUE(result.ok) << result.message;
+  // THEN the planted spike is named, in a suspect group with every reading
+  // of its row the data cannot tell from it, all of them left out
+  const std::vector<SensorReading>& rejected = result.calibration.rejected;
+  const auto named = std::find_if(rejected.begin(), rejected.end(), [](const SensorReading& r) {
+    return r.row == 6 && r.sensor == SensorKind::kForce;
+  });
+  ASSERT_NE(named, rejected.end());
+  EXPECT_NE(named->group, 0);
+  const auto members = std::count_if(rejected.begin(), rejected.end(), [&](const SensorReading& r) {
+    return r.row == 6 && r.group == named->group;
+  });
+  EXPECT_GE(members, 2);
+  EXPECT_FALSE(result.misfit) << result.calibration.model_warning;
+}
+
 TEST(RobustCalibration, AFitThatKeptAGrossErrorAndMisfitsIsRedoneFromTheBadRowLeftOut) {
   // GIVEN 8 poses of the small robot, nominal anchors 1 m off, a 1.75 m
   // encoder error and a load-cell spike, where the robust fit flags good

@@ -134,7 +134,9 @@ TEST(CalibrationToml, FormatThenParseGivesTheSameCalibration) {
   calibration.fit.cost_final = 0.1 + 0.2;
   calibration.effects["force_bias"] = {-1.0 / 9.0};
   calibration.effects["weird name"] = {1.0, 2.0};
-  calibration.rejected = {{12, SensorKind::kEncoder, 3, 87.25}, {30, SensorKind::kForce, 0, -12.5}};
+  calibration.rejected = {{12, SensorKind::kEncoder, 3, 87.25},
+                          {30, SensorKind::kForce, 0, -12.5, 1},
+                          {30, SensorKind::kEncoder, 2, 6.5, 1}};
   calibration.model_warning = "the residuals are 3.1 times the noise";
   // WHEN it is formatted and parsed again
   const std::string text = format_calibration_toml(calibration);
@@ -160,12 +162,13 @@ TEST(CalibrationToml, FormatThenParseGivesTheSameCalibration) {
   EXPECT_EQ(again->fit.rms_force_n, calibration.fit.rms_force_n);
   EXPECT_EQ(again->effects, calibration.effects);
   EXPECT_EQ(again->model_warning, calibration.model_warning);
-  ASSERT_EQ(again->rejected.size(), 2u);
-  for (std::size_t k = 0; k < 2; ++k) {
+  ASSERT_EQ(again->rejected.size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) {
     EXPECT_EQ(again->rejected[k].row, calibration.rejected[k].row);
     EXPECT_EQ(again->rejected[k].sensor, calibration.rejected[k].sensor);
     EXPECT_EQ(again->rejected[k].cable, calibration.rejected[k].cable);
     EXPECT_EQ(again->rejected[k].value, calibration.rejected[k].value);
+    EXPECT_EQ(again->rejected[k].group, calibration.rejected[k].group);
   }
 }
 
