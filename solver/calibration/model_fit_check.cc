@@ -2,15 +2,27 @@
 
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "solver/calibration/chi_square.h"
 
 namespace cdpr {
 
+namespace {
+
+// chi2 / dof above which a misfit is a fit that did not reach the readings
+// (rms normalised residual 100).
+constexpr double kUnreachedChiSquareRatio = 1e4;
+
+// What a fit that did not reach its minimum asks of the user.
+constexpr const char* kStartAdvice = "nominal anchors closer to the truth, more poses, or check the readings";
+
+}  // namespace
+
 void assess_model_fit(CalibrationResult& result, const CalibrationOptions& options) {
   Calibration& cal = result.calibration;
   const int globals = static_cast<int>(result.global_covariance.rows());
-  char text[512];
+  char text[640];
   if (result.degrees_of_freedom < globals) {
     std::snprintf(text, sizeof text,
                   "under-determined: %d samples leave %d redundant rows for %d global unknowns (anchors, offsets, "
@@ -21,16 +33,35 @@ void assess_model_fit(CalibrationResult& result, const CalibrationOptions& optio
     return;
   }
   result.misfit_probability = chi_square_upper_tail(result.chi_square, result.degrees_of_freedom);
+  const bool stopped = result.solver.termination == TerminationType::kMaxIterations;
+  if (stopped) {
+    std::snprintf(text, sizeof text,
+                  "not converged: the solver stopped at its iteration limit (%d iterations), not at a minimum "
+                  "(chi-square %.1f for %d degrees of freedom, p = %.1e); the anchors and their sigmas do not hold: "
+                  "%s",
+                  result.solver.iterations, result.chi_square, result.degrees_of_freedom, result.misfit_probability,
+                  kStartAdvice);
+    result.misfit = true;
+    cal.model_warning = text;
+  }
   if (result.misfit_probability >= options.misfit_alpha) return;
   const double ratio = result.chi_square / result.degrees_of_freedom;
   const double scale = std::sqrt(ratio);
+  // Residuals far beyond what any missing model term leaves (a weightless
+  // cable fitted as a catenary: chi2 / dof about 100) say the fit did not
+  // reach the readings, not that the model lacks a term.
+  const std::string why =
+      stopped ? std::string("The solver stopped at its iteration limit, not at a minimum: ") + kStartAdvice
+      : ratio > kUnreachedChiSquareRatio
+          ? std::string("No missing model term leaves residuals this large: the fit did not reach the readings; the "
+                        "anchors and their sigmas mean nothing: ") + kStartAdvice + " (readings of taut cables?)"
+          : std::string("A hidden effect (elasticity, centre of mass, density, load cell, ...) or wrong noise sigmas: "
+                        "run cdpr-calib diagnose");
   std::snprintf(text, sizeof text,
                 "the model does not fit the data: chi-square %.1f for %d degrees of freedom (%.2f times the noise "
-                "of robot.toml, p = %.1e < %.0e); rms encoder %.4f m, rms force %.2f N; sigmas scaled up by %.2f. "
-                "A hidden effect (elasticity, centre of mass, density, load cell, ...) or wrong noise sigmas: run "
-                "cdpr-calib diagnose",
+                "of robot.toml, p = %.1e < %.0e); rms encoder %.4f m, rms force %.2f N; sigmas scaled up by %.2f. %s",
                 result.chi_square, result.degrees_of_freedom, ratio, result.misfit_probability, options.misfit_alpha,
-                cal.fit.rms_encoder_m, cal.fit.rms_force_n, scale);
+                cal.fit.rms_encoder_m, cal.fit.rms_force_n, scale, why.c_str());
   result.misfit = true;
   cal.model_warning = text;
   for (WinchCalibration& w : cal.winches) {

@@ -2,6 +2,8 @@
 // paper's Table I model check against the simulator's equilibrium.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 
 #include <CLI/CLI.hpp>
 
@@ -9,6 +11,9 @@
 #include "cdpr-accuracy/model_check.h"
 #include "cdpr-accuracy/replay.h"
 #include "solver/calibration/chi_square.h"
+#include "src/formats/calibration_toml.h"
+#include "src/formats/robot_toml.h"
+#include "src/formats/samples_csv.h"
 #include "version/version.h"
 
 namespace {
@@ -57,23 +62,46 @@ void print_honesty_summary(const std::vector<cdpr::accuracy::ReplayResult>& runs
               0.1 * runs_stated);
 }
 
+// --write-data: a replayed run's data set as cdpr-sim writes one, in
+// <dir>/seed<N>, to fit again with cdpr-calib solve or diagnose.
+bool write_run_data(const std::string& dir, const cdpr::accuracy::ReplayResult& r) {
+  const std::filesystem::path out = std::filesystem::path(dir) / ("seed" + std::to_string(r.seed));
+  std::error_code error;
+  std::filesystem::create_directories(out, error);
+  const std::pair<const char*, std::string> files[] = {
+      {"robot.toml", cdpr::formats::format_robot_toml(r.nominal)},
+      {"samples.csv", cdpr::formats::format_samples_csv(r.samples)},
+      {"truth.toml", cdpr::formats::format_truth_toml(r.truth)}};
+  for (const auto& [name, text] : files) {
+    std::ofstream file(out / name, std::ios::binary | std::ios::trunc);
+    file << text;
+    file.close();
+    if (!file) {
+      std::fprintf(stderr, "cdpr-accuracy: cannot write %s\n", (out / name).c_str());
+      return false;
+    }
+  }
+  return true;
+}
+
 // --strategy: replays a waypoint strategy per seed and prints its table row.
 int run_replay(const cdpr::accuracy::ReplayCase& c, const std::string& preset_name, const std::string& strategy,
-               int seeds, int first_seed, bool verbose) {
+               int seeds, int first_seed, bool verbose, const std::string& write_data) {
   std::vector<cdpr::accuracy::ReplayResult> runs;
   for (int s = 0; s < seeds; ++s) {
     runs.push_back(cdpr::accuracy::replay(c, static_cast<std::uint64_t>(first_seed + s)));
     const auto& r = runs.back();
+    if (!write_data.empty() && !r.samples.empty() && !write_run_data(write_data, r)) return 1;
     if (verbose) {
       std::printf("seed %3llu %s time %6.1f min waypoints %2d skipped %d travel %7.1f m (nearest neighbour alone "
                   "%7.1f m) anchor mean %.4f worst %.4f m offset %.4f m largest sigma anchor %.4f offset %.4f m "
                   "error/sigma RMS %.2f forecast of waypoints left: mean |error| %.1f, bias %+.1f%s%s %s\n",
-                  static_cast<unsigned long long>(r.seed), r.ok ? "ok    " : "FAILED", r.robot_time_s / 60.0,
+                  static_cast<unsigned long long>(r.seed), !r.ok ? "FAILED" : r.misfit ? "MISFIT" : "ok    ", r.robot_time_s / 60.0,
                   r.waypoints, r.skipped, r.travel_m, r.travel_nn_m, r.anchor_error_m, r.worst_anchor_error_m,
                   r.offset_error_m, r.largest_anchor_sigma_m, r.largest_offset_sigma_m,
                   r.normalised_count ? std::sqrt(r.normalised_sq_sum / r.normalised_count) : 0.0,
                   r.forecast_abs_error, r.forecast_bias, r.stop.empty() ? "" : " stop: ",
-                  r.stop.c_str(), r.ok ? "" : r.message.c_str());
+                  r.stop.c_str(), r.ok && !r.misfit ? "" : r.message.c_str());
       print_run_honesty(r.normalised);
     } else {
       std::fprintf(stderr, "\r%s: run %d/%d", strategy.c_str(), s + 1, seeds);
@@ -81,9 +109,10 @@ int run_replay(const cdpr::accuracy::ReplayCase& c, const std::string& preset_na
   }
   if (!verbose) std::fprintf(stderr, "\n");
   double time_s = 0.0, waypoints = 0.0, anchor = 0.0, worst = 0.0, offset = 0.0, sq = 0.0, travel = 0.0, nn = 0.0;
-  int count = 0, failures = 0;
+  int count = 0, failures = 0, misfits = 0;
   for (const auto& r : runs) {
     const double n = static_cast<double>(runs.size());
+    misfits += r.ok && r.misfit;
     time_s += r.robot_time_s / n;
     waypoints += r.waypoints / n;
     travel += r.travel_m / n;
@@ -95,10 +124,10 @@ int run_replay(const cdpr::accuracy::ReplayCase& c, const std::string& preset_na
     count += r.normalised_count;
     failures += !r.ok;
   }
-  std::printf("| %s, %.1f m off | %s | %.1f | %.1f | %.4f / %.4f | %.4f | %.2f |  (%d runs, %d failed; mean travel "
-              "%.0f m%s)\n",
+  std::printf("| %s, %.1f m off | %s | %.1f | %.1f | %.4f / %.4f | %.4f | %.2f |  (%d runs, %d failed, %d flagged "
+              "by the model-fit test; mean travel %.0f m%s)\n",
               preset_name.c_str(), c.anchor_perturbation_m, strategy.c_str(), time_s / 60.0, waypoints, anchor, worst,
-              offset, count ? std::sqrt(sq / count) : 0.0, static_cast<int>(runs.size()), failures, travel,
+              offset, count ? std::sqrt(sq / count) : 0.0, static_cast<int>(runs.size()), failures, misfits, travel,
               nn > 0.0 ? (", nearest neighbour alone " + std::to_string(static_cast<int>(nn + 0.5)) + " m").c_str() : "");
   print_honesty_summary(runs);
   return failures ? 1 : 0;
@@ -181,6 +210,9 @@ int main(int argc, char** argv) {
                  "about 100 readings)")
       ->check(CLI::PositiveNumber)->capture_default_str();
   bool no_replan = false;
+  std::string write_data;
+  app.add_option("--write-data", write_data,
+                 "replay: write each run's data set (robot.toml, samples.csv, truth.toml) to DIR/seed<N>");
   app.add_flag("--no-replan", no_replan,
                "sequential: keep the candidates planned from the nominal anchors (the daemon plans them again from "
                "its estimate)");
@@ -220,7 +252,7 @@ int main(int argc, char** argv) {
       replay_case.candidate_grid_z = candidate_grid[1];
     }
     replay_case.anchor_perturbation_m = perturbation >= 0 ? perturbation : 0.3;
-    return run_replay(replay_case, preset_name, strategy, seeds, first_seed, verbose);
+    return run_replay(replay_case, preset_name, strategy, seeds, first_seed, verbose, write_data);
   }
 
   cdpr::accuracy::Case c;

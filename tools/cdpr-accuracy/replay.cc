@@ -35,6 +35,12 @@ class Rig {
       if (state) break;
       state = sim::solve_equilibrium(data_.true_robot, planned.position_world, yaw_rad + turn_rad);
     }
+    // A true rest whose cable would sag to the floor is none: the planner
+    // keeps the tensions up with the nominal anchors, the true anchors can
+    // leave a cable nearly slack, and the simulator then solves its rest as
+    // a catenary hundreds of metres long hanging far below the floor (a
+    // payout no winch would make; the real cable would lie on the floor).
+    if (state && !above_floor(*state)) state = sim::EquilibriumResult(Unexpected{sim::EquilibriumFailure{}});
     const Pose& reached = state ? state->world_T_platform : planned;
     const double travel_m =
         calibration::winch_travel_m(data_.true_robot.robot, nominal_anchors(data_.true_robot.robot), at_, reached);
@@ -53,6 +59,16 @@ class Rig {
   }
 
   double robot_time_s() const { return robot_time_s_; }
+  // Each cable's lowest point above the floor (z = 0). A cable that leaves
+  // the attachment downwards (its vertical force on the platform v < 0)
+  // sags below it by (tension - h) / weight per length.
+  bool above_floor(const sim::Equilibrium& state) const {
+    const double weight_npm = data_.true_robot.cable_weight_per_length_npm();
+    return std::all_of(state.cables.begin(), state.cables.end(), [&](const sim::CableEquilibrium& cable) {
+      const double sag_m = cable.v_n < 0.0 ? (cable.tension_n - cable.h_n) / weight_npm : 0.0;
+      return cable.attachment_world.z() - sag_m > 0.0;
+    });
+  }
   double travel_m() const { return travel_m_; }
 
  private:
@@ -69,6 +85,8 @@ void score(const sim::SimulatedDataset& data, const CalibrationResult& fit, Repl
   r.ok = fit.ok;
   r.message = fit.message;
   if (!fit.ok) return;
+  r.misfit = fit.misfit;
+  if (fit.misfit) r.message = fit.calibration.model_warning;
   const int n = kCableCount;
   Eigen::VectorXd errors(4 * n), sigmas(4 * n);  // per cable: anchor axes, offset (global_covariance's order)
   for (int i = 0; i < n; ++i) {
@@ -199,6 +217,9 @@ ReplayResult replay(const ReplayCase& c, std::uint64_t seed) {
   r.robot_time_s = rig.robot_time_s();
   r.travel_m = rig.travel_m();
   r.waypoints = static_cast<int>(samples.size());
+  r.nominal = nominal;
+  r.truth = data->truth;
+  r.samples = samples;
   score(*data, calibrate(nominal, samples, CalibrationOptions{}), r);
   return r;
 }

@@ -28,9 +28,11 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "cdpr-accuracy/normalised_errors.h"
 #include "sim/presets.h"
+#include "solver/model/calibration.h"
 #include "src/calibration/sequential_planner.h"
 #include "src/calibration/waypoint_planner.h"
 
@@ -54,7 +56,10 @@ struct ReplayCase {
 struct ReplayResult {
   std::uint64_t seed = 0;
   bool ok = false;              // the final fit succeeded
-  std::string message;
+  // ...but did not pass the model-fit test or was under-determined: cdpr-calib
+  // solve exits 3 and the daemon's validation refuses it (model_warning says why).
+  bool misfit = false;
+  std::string message;          // why the fit failed, or its model_warning
   double robot_time_s = 0.0;
   double travel_m = 0.0;        // summed winch travel
   double travel_nn_m = 0.0;     // fixed plans: the same waypoints by nearest neighbour alone
@@ -73,6 +78,11 @@ struct ReplayResult {
   int normalised_count = 0;
   // The same errors against the final fit's full covariance.
   NormalisedErrors normalised;
+  // The run's data set as cdpr-calib reads it, to fit it again or diagnose
+  // it: the nominal robot, the rows measured, the truth.
+  Robot nominal;
+  std::vector<Sample> samples;
+  Truth truth;
 };
 
 // The daemon's planner settings for the preset's robot (waypoint box, limits).
