@@ -198,6 +198,7 @@ std::string format_show_response(const std::optional<store::CurrentCalibration>&
       reading["sensor"] = sensor_name(r.sensor);
       reading["cable"] = r.cable;
       reading["residual"] = r.value;
+      if (r.group != 0) reading["group"] = r.group;  // a suspect group of its row (calibration.toml [[rejected]])
       rejected.push_back(std::move(reading));
     }
     json["rejected"] = std::move(rejected);

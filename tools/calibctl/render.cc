@@ -1,5 +1,6 @@
 #include "calibctl/render.h"
 
+#include <algorithm>
 #include <cstdio>
 
 namespace cdpr::calibctl {
@@ -127,7 +128,14 @@ std::string render_show(const JsonValue& s) {
       const std::string sensor = r["sensor"].string();
       out += format("  row %4d  %-7s", r["row"].integer(), sensor.c_str());
       out += sensor == "force" ? std::string(8, ' ') : format(" cable %d", r["cable"].integer());
-      out += format("  %+8.1f sigma\n", r["residual"].number());
+      out += format("  %+8.1f sigma", r["residual"].number());
+      if (const JsonValue& group = r["group"]; !group.is_null() && group.integer() != 0) {
+        out += format("  suspect group %d", group.integer());
+      }
+      out += "\n";
+    }
+    if (std::any_of(rejected.begin(), rejected.end(), [](const JsonValue& r) { return !r["group"].is_null(); })) {
+      out += "  (a suspect group: its row holds a gross error the data cannot pin on one of its readings; all were left out)\n";
     }
   }
   if (const JsonValue run = s["run"]; !run.is_null()) {

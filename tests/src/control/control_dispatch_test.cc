@@ -136,6 +136,13 @@ TEST(ControlDispatch, ShowListsTheRejectedReadingsAndTheModelWarning) {
       "of freedom\",\"rejected\":[{\"row\":12,\"sensor\":\"encoder\",\"cable\":3,\"residual\":-95.4},"
       "{\"row\":24,\"sensor\":\"force\",\"cable\":0,\"residual\":8.25}],\"run\":null}\n"))
       << show;
+  // AND GIVEN a row whose load cell and encoder 2 are one suspect group WHEN shown THEN both carry the group
+  calibration.rejected = {{24, SensorKind::kForce, 0, 8.25, 1}, {24, SensorKind::kEncoder, 2, 6.5, 1}};
+  ASSERT_TRUE(rig.store.commit(calibration));
+  const std::string grouped = ask(rig, "show");
+  EXPECT_TRUE(contains(grouped, "{\"row\":24,\"sensor\":\"force\",\"cable\":0,\"residual\":8.25,\"group\":1},"
+                                "{\"row\":24,\"sensor\":\"encoder\",\"cable\":2,\"residual\":6.5,\"group\":1}]"))
+      << grouped;
 }
 
 TEST(ControlDispatch, GarbageGetsAnErrorLine) {
