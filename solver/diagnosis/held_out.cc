@@ -87,6 +87,33 @@ void add_held_out_information(const EffectPoseFactor& factor, const PosePriorFac
 
 }  // namespace
 
+double encoder_rms_m(const std::vector<HeldOutPose>& poses, int cable) {
+  double sum = 0.0;
+  int count = 0;
+  for (const HeldOutPose& pose : poses) {
+    for (int i = 0; i < kCableCount; ++i) {
+      if ((cable >= 0 && i != cable) || pose.sample.encoder_left_out[i]) continue;
+      sum += std::pow(pose.prediction.encoder_residual_m[i], 2);
+      ++count;
+    }
+  }
+  return std::sqrt(sum / std::max(1, count));
+}
+
+void set_residual_rms(HeldOutEvaluation& h) {
+  double sum_height = 0.0, sum_force = 0.0;
+  int force_count = 0;
+  for (const HeldOutPose& pose : h.poses) {
+    for (int i = 0; i < kCableCount; ++i) sum_height += std::pow(pose.prediction.height_residual_m[i], 2);
+    if (pose.sample.force_left_out) continue;
+    sum_force += std::pow(pose.prediction.force_residual_n, 2);
+    ++force_count;
+  }
+  h.rms_encoder_m = encoder_rms_m(h.poses);
+  h.rms_height_m = std::sqrt(sum_height / std::max<std::size_t>(1, kCableCount * h.poses.size()));
+  h.rms_force_n = std::sqrt(sum_force / std::max(1, force_count));
+}
+
 HeldOutEvaluation evaluate_held_out(const Robot& robot, const std::vector<Sample>& held_out,
                                     const CalibrationOptions& options, const CalibrationResult& trained) {
   HeldOutEvaluation out;
@@ -126,8 +153,6 @@ HeldOutEvaluation evaluate_held_out(const Robot& robot, const std::vector<Sample
     return out;
   }
 
-  double sum_encoder = 0.0, sum_height = 0.0, sum_force = 0.0;
-  int encoder_count = 0, force_count = 0;
   const Eigen::MatrixXd& sigma = trained.global_covariance;
   Eigen::MatrixXd information = Eigen::MatrixXd::Zero(sigma.rows(), sigma.cols());
   int residual_count = 0;
@@ -149,18 +174,6 @@ HeldOutEvaluation evaluate_held_out(const Robot& robot, const std::vector<Sample
       continue;
     }
     pose.chi2 = 2.0 * (cost + prior_cost);
-    // A reading left out as a gross error has a residual (the prediction
-    // is made anyway) but is not evidence of the model's misfit.
-    for (int i = 0; i < kCableCount; ++i) {
-      sum_height += std::pow(pose.prediction.height_residual_m[i], 2);
-      if (pose.sample.encoder_left_out[i]) continue;
-      sum_encoder += std::pow(pose.prediction.encoder_residual_m[i], 2);
-      ++encoder_count;
-    }
-    if (!pose.sample.force_left_out) {
-      sum_force += std::pow(pose.prediction.force_residual_n, 2);
-      ++force_count;
-    }
     residual_count += EffectPoseFactor::kResidualDim + 6;  // + the pose prior
     add_held_out_information(factor, prior, blocks, trained, global_columns(factor, trained), information);
     out.poses.push_back(pose);
@@ -169,10 +182,7 @@ HeldOutEvaluation evaluate_held_out(const Robot& robot, const std::vector<Sample
     out.message = "no held-out pose could be evaluated";
     return out;
   }
-  const double n = static_cast<double>(out.poses.size());
-  out.rms_encoder_m = std::sqrt(sum_encoder / std::max(1, encoder_count));
-  out.rms_height_m = std::sqrt(sum_height / (kCableCount * n));
-  out.rms_force_n = std::sqrt(sum_force / std::max(1, force_count));
+  set_residual_rms(out);
   // The solver's cost is 0.5 chi2 over every factor (no robust loss here);
   // each pose has 8 unknowns of its own (pose 6, reference force 2).
   out.chi2 = 2.0 * summary.final_cost;

@@ -29,6 +29,7 @@ struct HeldOutEvaluation {
   // degrees of freedom: residual count minus the per-pose unknowns.
   double chi2 = 0.0;
   int dof = 0;
+  // The residuals' rms over `poses` (set_residual_rms).
   double rms_encoder_m = 0.0;
   double rms_height_m = 0.0;
   double rms_force_n = 0.0;
@@ -44,6 +45,14 @@ struct HeldOutEvaluation {
   // sqrt(chi2 / expected_chi2): 1 at the noise floor.
   double normalized_rms() const;
 };
+
+// The rms of the held-out encoder residuals of the readings the fits used
+// (a reading left out as a gross error is predicted too, but is no evidence
+// of misfit): every cable's, or cable `cable`'s alone. 0 with none.
+double encoder_rms_m(const std::vector<HeldOutPose>& poses, int cable = -1);
+// Sets h's rms_encoder_m, rms_height_m and rms_force_n from h.poses (the
+// encoders and the load cell as encoder_rms_m: readings used only).
+void set_residual_rms(HeldOutEvaluation& h);
 
 // `trained` must be an ok result of calibrate() with the same options
 // (cable model catenary; options.effects in the same order as trained.effects).

@@ -10,19 +10,13 @@ namespace {
 
 // Pools one fold's held-out evaluation into the total.
 void pool(HeldOutEvaluation& total, HeldOutEvaluation&& part) {
-  const double n_total = static_cast<double>(total.poses.size()), n_part = static_cast<double>(part.poses.size());
-  const auto mean_square = [&](double a, double b) {
-    return std::sqrt((a * a * n_total + b * b * n_part) / std::max(1.0, n_total + n_part));
-  };
-  total.rms_encoder_m = mean_square(total.rms_encoder_m, part.rms_encoder_m);
-  total.rms_height_m = mean_square(total.rms_height_m, part.rms_height_m);
-  total.rms_force_n = mean_square(total.rms_force_n, part.rms_force_n);
   total.chi2 += part.chi2;
   total.expected_chi2 += part.expected_chi2;
   total.chi2_variance += part.chi2_variance;
   total.dof += part.dof;
   total.rejected_samples.insert(total.rejected_samples.end(), part.rejected_samples.begin(), part.rejected_samples.end());
   for (HeldOutPose& pose : part.poses) total.poses.push_back(std::move(pose));
+  set_residual_rms(total);
 }
 
 // options.fit with the model's effects and no progress of its own.

@@ -231,14 +231,7 @@ std::string rms_table(const std::vector<Evaluation>& evaluations) {
   for (const Evaluation& e : evaluations) {
     std::vector<std::string> row{e.caption};
     for (int i = 0; i < kCableCount; ++i) {
-      double sum = 0.0;
-      int count = 0;
-      for (const HeldOutPose& p : e.held_out->poses) {
-        if (p.sample.encoder_left_out[i]) continue;  // a gross error, not the model's misfit
-        sum += std::pow(p.prediction.encoder_residual_m[i], 2);
-        ++count;
-      }
-      row.push_back(format("%.2f", 1000.0 * std::sqrt(sum / std::max(1, count))));
+      row.push_back(format("%.2f", 1000.0 * encoder_rms_m(e.held_out->poses, i)));
     }
     row.push_back(format("%.2f", e.held_out->rms_force_n));
     rows.push_back(row);
