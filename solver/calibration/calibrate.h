@@ -94,6 +94,18 @@ struct FittedRow {
   Eigen::Vector2d reference_force = Eigen::Vector2d::Zero();
 };
 
+// Why a fit is flagged (CalibrationResult::misfit), the first that applies.
+enum class MisfitCause {
+  kNone,
+  kUnderDetermined,  // fewer redundant rows than global unknowns
+  kNotConverged,     // the solver stopped at its iteration limit
+  kUnreached,        // residuals far beyond any missing term: the fit missed the readings
+  kModel,            // the readings ask for a term the model lacks (chi-square or score test)
+};
+
+// What the user should do about a flagged fit, one sentence.
+const char* misfit_advice(MisfitCause cause);
+
 struct CalibrationResult {
   bool ok = false;
   std::string message;      // why it failed, or the solver's termination message
@@ -115,6 +127,10 @@ struct CalibrationResult {
   int degrees_of_freedom = 0;
   double misfit_probability = 1.0;
   bool misfit = false;
+  // What the flag is about, for the advice that goes with it: only a model
+  // that lacks a term is a case for cdpr-calib diagnose; a fit that stopped
+  // short or an under-determined problem needs a better start or more poses.
+  MisfitCause misfit_cause = MisfitCause::kNone;
   // The tests of the terms the model lacks, in kAllEffects order (when ok,
   // catenary and the model-fit check on); per-term level in term_test_level.
   std::vector<TermTest> term_tests;

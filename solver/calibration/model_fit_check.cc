@@ -19,6 +19,17 @@ constexpr const char* kStartAdvice = "nominal anchors closer to the truth, more 
 
 }  // namespace
 
+const char* misfit_advice(MisfitCause cause) {
+  switch (cause) {
+    case MisfitCause::kNone: return "";
+    case MisfitCause::kUnderDetermined: return "add poses, spread over the workspace";
+    case MisfitCause::kNotConverged:
+    case MisfitCause::kUnreached: return kStartAdvice;
+    case MisfitCause::kModel: return "run cdpr-calib diagnose on the same data to find the missing model term";
+  }
+  return "";
+}
+
 void assess_model_fit(CalibrationResult& result, const CalibrationOptions& options) {
   Calibration& cal = result.calibration;
   const int globals = static_cast<int>(result.global_covariance.rows());
@@ -29,6 +40,7 @@ void assess_model_fit(CalibrationResult& result, const CalibrationOptions& optio
                   "model terms); the sigmas are large and may not hold; add poses",
                   cal.samples, result.degrees_of_freedom, globals);
     result.misfit = true;
+    result.misfit_cause = MisfitCause::kUnderDetermined;
     cal.model_warning = text;
     return;
   }
@@ -42,6 +54,7 @@ void assess_model_fit(CalibrationResult& result, const CalibrationOptions& optio
                   result.solver.iterations, result.chi_square, result.degrees_of_freedom, result.misfit_probability,
                   kStartAdvice);
     result.misfit = true;
+    result.misfit_cause = MisfitCause::kNotConverged;
     cal.model_warning = text;
   }
   if (result.misfit_probability >= options.misfit_alpha) return;
@@ -63,6 +76,7 @@ void assess_model_fit(CalibrationResult& result, const CalibrationOptions& optio
                 result.chi_square, result.degrees_of_freedom, ratio, result.misfit_probability, options.misfit_alpha,
                 cal.fit.rms_encoder_m, cal.fit.rms_force_n, scale, why.c_str());
   result.misfit = true;
+  if (!stopped) result.misfit_cause = ratio > kUnreachedChiSquareRatio ? MisfitCause::kUnreached : MisfitCause::kModel;
   cal.model_warning = text;
   for (WinchCalibration& w : cal.winches) {
     w.anchor_sigma *= scale;

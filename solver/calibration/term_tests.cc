@@ -289,6 +289,7 @@ void test_missing_terms(const Robot& robot, const CalibrationOptions& options, C
   std::string& warning = result.calibration.model_warning;
   warning = warning.empty() ? text : warning + "; " + text;
   result.misfit = true;
+  if (result.misfit_cause == MisfitCause::kNone) result.misfit_cause = MisfitCause::kModel;
 }
 
 }  // namespace cdpr

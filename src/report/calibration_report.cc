@@ -28,7 +28,7 @@ Verdict verdict_of(const CalibrationReport& r, const std::vector<Trend>& trends)
   if (fit.misfit) {
     v.tone = Tone::kBad;
     v.conclusion = "The model does not explain the data (chi2/dof " + format("%.2f", ratio) +
-                   "): do not trust this calibration as it is; run cdpr-calib diagnose on the same data";
+                   "): do not trust this calibration as it is; " + misfit_advice(fit.misfit_cause);
     if (!trends.empty()) v.conclusion += ". Strongest residual trend: " + strongest_trend_text(trends);
   } else {
     v.conclusion = "The model explains the data down to the sensor noise";

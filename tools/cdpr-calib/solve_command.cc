@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <string>
 
 #include "model_option.h"
 #include "input_files.h"
@@ -116,10 +117,14 @@ int run_solve(const SolveArgs& args) {
   }
   if (!args.report_dir.empty() && !write_report(args, *inputs, options, result, truth)) return 1;
   if (result.misfit && !args.accept_misfit) {
+    const std::string advice =
+        result.misfit_cause == MisfitCause::kModel
+            ? "run `cdpr-calib diagnose " + args.robot_path + " " + args.samples_path + "` to find the missing model term"
+            : misfit_advice(result.misfit_cause);
     std::fprintf(stderr,
-                 "cdpr-calib: %s\ncdpr-calib: the calibration was written but is not to be trusted as it is; "
-                 "run `cdpr-calib diagnose %s %s` to find the missing model term, or pass --accept-misfit\n",
-                 result.calibration.model_warning.c_str(), args.robot_path.c_str(), args.samples_path.c_str());
+                 "cdpr-calib: %s\ncdpr-calib: the calibration was written but is not to be trusted as it is: %s; "
+                 "or pass --accept-misfit\n",
+                 result.calibration.model_warning.c_str(), advice.c_str());
     return 3;
   }
   return 0;

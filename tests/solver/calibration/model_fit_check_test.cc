@@ -34,6 +34,9 @@ TEST(ModelFitCheck, AFitThatStoppedAtTheIterationLimitIsNotAGoodCalibration) {
   // THEN it is flagged (cdpr-calib solve exits 3, the daemon refuses it) as not converged
   EXPECT_TRUE(r.misfit);
   EXPECT_NE(r.calibration.model_warning.find("not converged"), std::string::npos) << r.calibration.model_warning;
+  // AND the advice is a better start, not a hunt for a model term
+  EXPECT_EQ(r.misfit_cause, MisfitCause::kNotConverged);
+  EXPECT_EQ(std::string(misfit_advice(r.misfit_cause)).find("diagnose"), std::string::npos);
   // AND its sigmas are not scaled: the chi-square does not ask for it
   EXPECT_DOUBLE_EQ(r.calibration.winches[0].offset_sigma_m, 0.01);
 }
@@ -47,6 +50,18 @@ TEST(ModelFitCheck, ResidualsNoModelTermLeavesAreAFitThatDidNotReachTheReadings)
   EXPECT_TRUE(r.misfit);
   EXPECT_NE(r.calibration.model_warning.find("did not reach the readings"), std::string::npos);
   EXPECT_EQ(r.calibration.model_warning.find("run cdpr-calib diagnose"), std::string::npos);
+  EXPECT_EQ(r.misfit_cause, MisfitCause::kUnreached);
+  EXPECT_EQ(std::string(misfit_advice(r.misfit_cause)).find("diagnose"), std::string::npos);
+}
+
+TEST(ModelFitCheck, TooFewRedundantRowsAskForPosesNotForAModelTerm) {
+  // GIVEN a fit with fewer redundant rows than its 16 global unknowns
+  CalibrationResult r = fit_with(5.0, 8, TerminationType::kConverged);
+  assess_model_fit(r, CalibrationOptions{});
+  // THEN it is flagged as under-determined and the advice is more poses
+  EXPECT_TRUE(r.misfit);
+  EXPECT_EQ(r.misfit_cause, MisfitCause::kUnderDetermined);
+  EXPECT_NE(std::string(misfit_advice(r.misfit_cause)).find("poses"), std::string::npos);
 }
 
 TEST(ModelFitCheck, AModestMisfitPointsToAHiddenEffect) {
@@ -57,6 +72,8 @@ TEST(ModelFitCheck, AModestMisfitPointsToAHiddenEffect) {
   EXPECT_TRUE(r.misfit);
   EXPECT_NEAR(r.calibration.winches[0].offset_sigma_m, 0.01 * std::sqrt(1.5), 1e-12);
   EXPECT_NE(r.calibration.model_warning.find("run cdpr-calib diagnose"), std::string::npos);
+  EXPECT_EQ(r.misfit_cause, MisfitCause::kModel);
+  EXPECT_NE(std::string(misfit_advice(r.misfit_cause)).find("diagnose"), std::string::npos);
 }
 
 TEST(ModelFitCheck, AConvergedFitThatFitsPasses) {
@@ -64,6 +81,7 @@ TEST(ModelFitCheck, AConvergedFitThatFitsPasses) {
   assess_model_fit(r, CalibrationOptions{});
   EXPECT_FALSE(r.misfit);
   EXPECT_TRUE(r.calibration.model_warning.empty());
+  EXPECT_EQ(r.misfit_cause, MisfitCause::kNone);
 }
 
 }  // namespace
