@@ -9,6 +9,7 @@
 
 #include "src/calibration/model_check_verdict.h"
 #include "src/formats/number_text.h"
+#include "src/report/sections.h"
 
 namespace cdpr::control {
 namespace {
@@ -198,7 +199,11 @@ std::string format_show_response(const std::optional<store::CurrentCalibration>&
       reading["sensor"] = sensor_name(r.sensor);
       reading["cable"] = r.cable;
       reading["residual"] = r.value;
-      if (r.group != 0) reading["group"] = r.group;  // a suspect group of its row (calibration.toml [[rejected]])
+      // A suspect group of its row (calibration.toml [[rejected]]) and its members in words.
+      if (r.group != 0) {
+        reading["group"] = r.group;
+        reading["group_members"] = report::suspect_group_text(c.rejected, r);
+      }
       rejected.push_back(std::move(reading));
     }
     json["rejected"] = std::move(rejected);

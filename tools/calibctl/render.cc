@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "src/report/suspect_group_note.h"
+
 namespace cdpr::calibctl {
 namespace {
 
@@ -129,13 +131,15 @@ std::string render_show(const JsonValue& s) {
       out += format("  row %4d  %-7s", r["row"].integer(), sensor.c_str());
       out += sensor == "force" ? std::string(8, ' ') : format(" cable %d", r["cable"].integer());
       out += format("  %+8.1f sigma", r["residual"].number());
-      if (const JsonValue& group = r["group"]; !group.is_null() && group.integer() != 0) {
-        out += format("  suspect group %d", group.integer());
+      if (const JsonValue& members = r["group_members"]; !members.is_null()) {
+        out += "  suspect group: " + members.string();
+      } else if (const JsonValue& group = r["group"]; !group.is_null() && group.integer() != 0) {
+        out += format("  suspect group %d", group.integer());  // a daemon that does not name the members
       }
       out += "\n";
     }
     if (std::any_of(rejected.begin(), rejected.end(), [](const JsonValue& r) { return !r["group"].is_null(); })) {
-      out += "  (a suspect group: its row holds a gross error the data cannot pin on one of its readings; all were left out)\n";
+      out += std::string("  ") + report::kSuspectGroupNote + "\n";
     }
   }
   if (const JsonValue run = s["run"]; !run.is_null()) {

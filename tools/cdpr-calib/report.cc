@@ -5,6 +5,7 @@
 #include <ctime>
 
 #include "src/report/sections.h"
+#include "src/report/suspect_group_note.h"
 
 namespace cdpr::tools {
 
@@ -72,8 +73,7 @@ void print_gross_errors(std::FILE* out, const std::vector<SensorReading>& reject
     std::fprintf(out, "\n");
   }
   if (std::any_of(rejected.begin(), rejected.end(), [](const SensorReading& r) { return r.group != 0; })) {
-    std::fprintf(out, "  (a suspect group: its row holds a gross error the data cannot pin on one of its readings; "
-                      "all of them were left out)\n");
+    std::fprintf(out, "  %s\n", report::kSuspectGroupNote);
   }
 }
 

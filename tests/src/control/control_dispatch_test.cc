@@ -140,8 +140,11 @@ TEST(ControlDispatch, ShowListsTheRejectedReadingsAndTheModelWarning) {
   calibration.rejected = {{24, SensorKind::kForce, 0, 8.25, 1}, {24, SensorKind::kEncoder, 2, 6.5, 1}};
   ASSERT_TRUE(rig.store.commit(calibration));
   const std::string grouped = ask(rig, "show");
-  EXPECT_TRUE(contains(grouped, "{\"row\":24,\"sensor\":\"force\",\"cable\":0,\"residual\":8.25,\"group\":1},"
-                                "{\"row\":24,\"sensor\":\"encoder\",\"cable\":2,\"residual\":6.5,\"group\":1}]"))
+  // AND name the group's members in words, for calibctl show
+  EXPECT_TRUE(contains(grouped, "{\"row\":24,\"sensor\":\"force\",\"cable\":0,\"residual\":8.25,\"group\":1,"
+                                "\"group_members\":\"force or encoder cable 2\"},"
+                                "{\"row\":24,\"sensor\":\"encoder\",\"cable\":2,\"residual\":6.5,\"group\":1,"
+                                "\"group_members\":\"force or encoder cable 2\"}]"))
       << grouped;
 }
 
