@@ -218,11 +218,38 @@ std::optional<CalibrationResult> consensus_start(const Robot& robot, const std::
 // change is kept when a reading it newly leaves out is predicted beyond the
 // threshold and the fit explains the readings better (start_score) without
 // starting to misfit; then the search starts over, a bounded number of times.
+//
+// A fit refused for too many rows with gross errors gets the search too:
+// an absorbed gross error makes its cable's good readings look bad on
+// other rows, and those rows can be what tips the count over the bar. Its
+// readings are left out and the fit redone anyway, the search run from
+// there, and the result kept only when it leaves readings out on no more
+// rows than allowed and passes the model-fit test; otherwise the refusal
+// stands. Changes only put readings back or move them, so the rows left
+// out never grow, and each reading still out is predicted beyond the
+// threshold or costs the fit more than leaving it out.
 CalibrationResult swap_within_rows(const Robot& robot, const std::vector<Sample>& samples,
                                    const CalibrationOptions& options, CalibrationResult result) {
-  if (samples.size() > kSmallSetRows || options.cable_model != CableModelKind::kCatenary || !result.ok) return result;
+  if (samples.size() > kSmallSetRows || options.cable_model != CableModelKind::kCatenary) return result;
   CalibrationOptions plain = options;
   plain.robust = false;
+  const bool refused = !result.ok;
+  if (refused) {
+    if (result.gross_errors.empty() || !has_anchors(result) ||
+        gross_error_row_fraction(result, samples.size()) <= options.max_rejected_fraction) {
+      return result;
+    }
+    CalibrationResult fit = calibrate_with_restart(started_at(robot, result),
+                                                   leave_out(samples, result.gross_errors, options.cable_model), plain);
+    if (!fit.ok) return result;
+    fit.gross_errors = result.gross_errors;
+    fit.calibration.rejected = result.gross_errors;
+    note_left_out(fit);
+    assess_model_fit(fit, options);
+    const CalibrationResult searched = swap_within_rows(robot, samples, options, std::move(fit));
+    const bool within = gross_error_row_fraction(searched, samples.size()) <= options.max_rejected_fraction;
+    return within && !searched.misfit ? searched : result;
+  }
   auto same = [](const SensorReading& a, const SensorReading& b) {
     return a.row == b.row && a.sensor == b.sensor && a.cable == b.cable;
   };
