@@ -8,6 +8,7 @@
 
 #include "solver/calibration/gross_errors.h"
 #include "solver/calibration/model_fit_check.h"
+#include "solver/calibration/row_attribution.h"
 #include "solver/calibration/single_fit.h"
 #include "solver/calibration/start_selection.h"
 #include "solver/calibration/term_tests.h"
@@ -218,11 +219,38 @@ std::optional<CalibrationResult> consensus_start(const Robot& robot, const std::
 // change is kept when a reading it newly leaves out is predicted beyond the
 // threshold and the fit explains the readings better (start_score) without
 // starting to misfit; then the search starts over, a bounded number of times.
+//
+// A fit refused for too many rows with gross errors gets the search too:
+// an absorbed gross error makes its cable's good readings look bad on
+// other rows, and those rows can be what tips the count over the bar. Its
+// readings are left out and the fit redone anyway, the search run from
+// there, and the result kept only when it leaves readings out on no more
+// rows than allowed and passes the model-fit test; otherwise the refusal
+// stands. Changes only put readings back or move them, so the rows left
+// out never grow, and each reading still out is predicted beyond the
+// threshold or costs the fit more than leaving it out.
 CalibrationResult swap_within_rows(const Robot& robot, const std::vector<Sample>& samples,
                                    const CalibrationOptions& options, CalibrationResult result) {
-  if (samples.size() > kSmallSetRows || options.cable_model != CableModelKind::kCatenary || !result.ok) return result;
+  if (samples.size() > kSmallSetRows || options.cable_model != CableModelKind::kCatenary) return result;
   CalibrationOptions plain = options;
   plain.robust = false;
+  const bool refused = !result.ok;
+  if (refused) {
+    if (result.gross_errors.empty() || !has_anchors(result) ||
+        gross_error_row_fraction(result, samples.size()) <= options.max_rejected_fraction) {
+      return result;
+    }
+    CalibrationResult fit = calibrate_with_restart(started_at(robot, result),
+                                                   leave_out(samples, result.gross_errors, options.cable_model), plain);
+    if (!fit.ok) return result;
+    fit.gross_errors = result.gross_errors;
+    fit.calibration.rejected = result.gross_errors;
+    note_left_out(fit);
+    assess_model_fit(fit, options);
+    const CalibrationResult searched = swap_within_rows(robot, samples, options, std::move(fit));
+    const bool within = gross_error_row_fraction(searched, samples.size()) <= options.max_rejected_fraction;
+    return within && !searched.misfit ? searched : result;
+  }
   auto same = [](const SensorReading& a, const SensorReading& b) {
     return a.row == b.row && a.sensor == b.sensor && a.cable == b.cable;
   };
@@ -401,6 +429,48 @@ CalibrationResult best_of_starts(const Robot& robot, const std::vector<Sample>& 
   return best;
 }
 
+// A gross error that its row's pose and reference force absorb keeps a
+// small residual, so the robust fit never flags its row, though leaving it
+// out lowers the chi-square by more than threshold^2 (hidden_gross_errors,
+// solver/calibration/row_attribution.h). Each such reading, worst first, is
+// left out and the fit redone by least squares; it stays out when the
+// refit explains the readings better (start_score: its chi-square drop
+// above threshold^2, the likelihood-ratio bar every gross error meets)
+// without starting to misfit, and the test starts over. Not on a fit that
+// misfits: its large residuals are a missing term's signature.
+CalibrationResult leave_out_hidden_errors(const Robot& robot, const std::vector<Sample>& samples,
+                                          const CalibrationOptions& options, CalibrationResult result) {
+  if (!result.ok || result.misfit || !options.robust || options.cable_model != CableModelKind::kCatenary) {
+    return result;
+  }
+  CalibrationOptions plain = options;
+  plain.robust = false;
+  const double threshold = options.rejection_threshold_sigma;
+  for (std::size_t round = 0; round < samples.size(); ++round) {
+    bool changed = false;
+    for (const SensorReading& hidden : hidden_gross_errors(robot, options, result, threshold)) {
+      std::vector<SensorReading> out = result.gross_errors;
+      out.push_back(hidden);
+      CalibrationResult refit =
+          calibrate_with_restart(started_at(robot, result), leave_out(samples, out, options.cable_model), plain);
+      if (!refit.ok) continue;
+      for (const SensorReading& p : refit.left_out_residuals) {
+        if (p.row == hidden.row && p.sensor == hidden.sensor && p.cable == hidden.cable) out.back().value = p.value;
+      }
+      refit.gross_errors = out;
+      refit.calibration.rejected = out;
+      note_left_out(refit);
+      assess_model_fit(refit, options);
+      if (refit.misfit || !better_fit(refit, result, threshold)) continue;
+      result = std::move(refit);
+      changed = true;
+      break;
+    }
+    if (!changed) break;
+  }
+  return result;
+}
+
 }  // namespace
 
 CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& samples, const CalibrationOptions& options) {
@@ -409,6 +479,7 @@ CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& sampl
     // The set the kept fit left out gets its swap test once, at the end.
     result = swap_within_rows(robot, samples, options, best_of_starts(robot, samples, options, std::move(result)));
   }
+  result = leave_out_hidden_errors(robot, samples, options, std::move(result));
   settle_groups(result.gross_errors);
   settle_groups(result.calibration.rejected);
   // Once, on the fit kept: the choice among fits above is by the chi-square test alone.

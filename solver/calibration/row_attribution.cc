@@ -1,11 +1,14 @@
 #include "solver/calibration/row_attribution.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
 #include <Eigen/Cholesky>
 
+#include "solver/calibration/effect_pose_factor.h"
+#include "solver/calibration/pose_prior_factor.h"
 #include "solver/nls/factor_parameters.h"
 #include "solver/nls/trust_region_strategy.h"
 
@@ -273,6 +276,97 @@ std::vector<SensorReading> attribute_row(const Problem& problem, int row_id, int
   }
   std::vector<SensorReading> out;
   for (int j : left_out) out.push_back({row_id, readings[j].sensor, readings[j].cable, now.residuals[j], groups[j]});
+  return out;
+}
+
+std::vector<SensorReading> hidden_gross_errors(const Robot& robot, const CalibrationOptions& options,
+                                               const CalibrationResult& result, double bar_sigma) {
+  constexpr int kFactorRows = EffectPoseFactor::kResidualDim;
+  constexpr int kPriorRows = 6;
+  constexpr int kLocal = 8;  // pose tangent (6), reference force (2)
+  std::vector<SensorReading> out;
+  if (!result.ok || options.cable_model != CableModelKind::kCatenary ||
+      result.calibration.winches.size() != static_cast<std::size_t>(kCableCount) ||
+      result.effects.size() != options.effects.size()) {
+    return out;
+  }
+  // Parameter blocks in EffectPoseFactor's keys() order.
+  std::array<double, 7> pose{};
+  std::array<double, 2> force{};
+  std::array<std::array<double, 3>, kCableCount> anchors{};
+  std::array<double, kCableCount> offsets{};
+  std::vector<std::vector<double>> effect_values;
+  std::vector<const double*> parameters{pose.data(), force.data()};
+  for (int i = 0; i < kCableCount; ++i) {
+    for (int a = 0; a < 3; ++a) anchors[i][a] = result.calibration.winches[i].anchor_world(a);
+    offsets[i] = result.calibration.winches[i].offset_m;
+    parameters.push_back(anchors[i].data());
+  }
+  for (int i = 0; i < kCableCount; ++i) parameters.push_back(&offsets[i]);
+  for (const FittedEffect& e : result.effects) effect_values.push_back(e.value);
+  for (const std::vector<double>& v : effect_values) parameters.push_back(v.data());
+
+  std::array<double, kFactorRows * 6> pose_jacobian{};
+  std::array<double, kFactorRows * 2> force_jacobian{};
+  std::vector<double*> jacobians(parameters.size(), nullptr);
+  jacobians[0] = pose_jacobian.data();
+  jacobians[1] = force_jacobian.data();
+  std::array<double, kPriorRows * 6> prior_jacobian{};
+  double* prior_jacobians[] = {prior_jacobian.data()};
+  std::array<double, kFactorRows> residual{};
+  std::array<double, kPriorRows> prior_residual{};
+  const Loss loss{options.huber_width};
+  for (std::size_t k = 0; k < result.fitted_rows.size(); ++k) {
+    const FittedRow& row = result.fitted_rows[k];
+    const Eigen::Vector3d& p = row.world_T_platform.position_world;
+    const Eigen::Quaterniond& q = row.world_T_platform.world_R_platform;
+    pose = {p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z()};
+    force = {row.reference_force(0), row.reference_force(1)};
+    const SampleSigmas sigma = reading_sigmas(robot, row.sample);
+    const int index = static_cast<int>(k);
+    const PosePriorFactor prior(index, {row.sample.position_world, row.sample.world_R_platform}, sigma.position_m,
+                                sigma.orientation_rad, loss);
+    const EffectPoseFactor factor(robot, index, row.sample, options.height_sigma_m, loss, options.effects);
+    double cost = 0.0;
+    if (!prior.evaluate(parameters.data(), prior_residual.data(), prior_jacobians, &cost) ||
+        !factor.evaluate(parameters.data(), residual.data(), jacobians.data(), &cost)) {
+      continue;
+    }
+    Eigen::Matrix<double, kFactorRows + kPriorRows, kLocal> j = Eigen::Matrix<double, kFactorRows + kPriorRows, kLocal>::Zero();
+    for (int r = 0; r < kFactorRows; ++r) {
+      for (int c = 0; c < 6; ++c) j(r, c) = pose_jacobian[r * 6 + c];
+      for (int c = 0; c < 2; ++c) j(r, 6 + c) = force_jacobian[r * 2 + c];
+    }
+    for (int r = 0; r < kPriorRows; ++r) {
+      for (int c = 0; c < 6; ++c) j(kFactorRows + r, c) = prior_jacobian[r * 6 + c];
+    }
+    if (!j.allFinite()) continue;
+    const Eigen::LDLT<Eigen::Matrix<double, kLocal, kLocal>> information(j.transpose() * j);
+    if (information.info() != Eigen::Success || !information.isPositive()) continue;
+    const LeftOutRows left_out = left_out_rows(row.sample);
+    std::vector<SensorReading> studentised;
+    for (int reading = 0; reading <= kCableCount; ++reading) {
+      const int r = kReadingRows[reading];
+      if (std::find(left_out.rows.begin(), left_out.rows.begin() + left_out.count, r) !=
+          left_out.rows.begin() + left_out.count) {
+        continue;
+      }
+      const Eigen::Matrix<double, kLocal, 1> jr = j.row(r).transpose();
+      const double free = 1.0 - jr.dot(information.solve(jr));
+      if (!(free > 1e-9) || !std::isfinite(residual[r])) continue;
+      const bool force_row = reading == kCableCount;
+      studentised.push_back({row.sample.id, force_row ? SensorKind::kForce : SensorKind::kEncoder,
+                             force_row ? robot.reference_cable : reading, residual[r] / std::sqrt(free)});
+    }
+    for (const SensorReading& s : studentised) {
+      const bool told_apart = std::all_of(studentised.begin(), studentised.end(), [&](const SensorReading& o) {
+        return &o == &s || s.value * s.value - o.value * o.value > kAmbiguousChi2;
+      });
+      if (std::abs(s.value) > bar_sigma && told_apart) out.push_back(s);
+    }
+  }
+  std::sort(out.begin(), out.end(),
+            [](const SensorReading& a, const SensorReading& b) { return std::abs(a.value) > std::abs(b.value); });
   return out;
 }
 

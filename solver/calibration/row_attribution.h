@@ -21,6 +21,7 @@
 
 #include <vector>
 
+#include "solver/calibration/calibrate.h"
 #include "solver/model/calibration.h"
 #include "solver/nls/problem.h"
 
@@ -42,5 +43,24 @@ struct RowReading {
 std::vector<SensorReading> attribute_row(const Problem& problem, int row_id, int pose_index,
                                          const std::vector<int>& row_factors, const std::vector<RowReading>& readings,
                                          double threshold_sigma);
+
+// The readings a final catenary fit kept that look like gross errors once
+// studentised within their row: the whitened residual r over sqrt(1 - h),
+// h its leverage in the fit of the row's own pose and reference force (its
+// readings, height rows and pose prior; every global held). r^2 / (1 - h)
+// is, to first order, the chi-square drop when the reading is left out and
+// the row refitted: the likelihood-ratio statistic of "this reading is a
+// gross error". The residual alone understates it where the row's pose
+// takes most of an error: a load cell whose row's orientation absorbs
+// 86 N (17 sigma) keeps a residual of 2 sigma, while leaving it out lowers
+// the chi-square by 38. Holding the globals makes it an upper bound of the
+// drop a full refit gives. Returned: each reading whose studentised
+// residual (its value) exceeds bar_sigma and whose statistic exceeds every
+// other reading's of its row by more than 10.83 (the data tell it from
+// them, as in attribute_row), worst first. Readings the row's unknowns
+// carry entirely (h within 1e-9 of 1) are not tested. Empty when the fit
+// failed or is rigid.
+std::vector<SensorReading> hidden_gross_errors(const Robot& robot, const CalibrationOptions& options,
+                                               const CalibrationResult& result, double bar_sigma);
 
 }  // namespace cdpr
