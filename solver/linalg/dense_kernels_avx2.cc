@@ -28,6 +28,7 @@ Quad splat(double a) { return Quad{a, a, a, a}; }
 // arrays of vectors in memory).
 void tile8x4(int depth, const double* x, int ldx, const double* y, int ldy, double* out, int ldo, double sign) {
   Quad a0 = {}, a1 = {}, a2 = {}, a3 = {}, b0 = {}, b1 = {}, b2 = {}, b3 = {};
+#pragma GCC unroll 4
   for (int k = 0; k < depth; ++k) {
     const double* xk = x + k * ldx;
     const double* yk = y + k * ldy;
@@ -58,6 +59,7 @@ void tile8x4(int depth, const double* x, int ldx, const double* y, int ldy, doub
 template <int Cols>
 void tile4(int depth, const double* x, int ldx, const double* y, int ldy, double* out, int ldo, double sign) {
   Quad a0 = {}, a1 = {}, a2 = {}, a3 = {};
+#pragma GCC unroll 4
   for (int k = 0; k < depth; ++k) {
     const Quad xv = load(x + k * ldx);
     const double* yk = y + k * ldy;
@@ -145,14 +147,23 @@ void add_transposed_times_vector(int depth, int cols, const double* x, int ldx, 
   if (c < cols) add_transposed_times_vector_portable(depth, cols - c, x + c, ldx, v, sign, out + c);
 }
 
-void solve_upper_transposed_rows(int d, const double* u, const double* inverse, int m, const double* b, double* w) {
+namespace {
+
+// solve_upper_transposed_rows for d = D when D > 0 (known at compile time, the
+// row loops unroll completely: a pose group's d = 8 leaves no loop control
+// in the substitution), else the runtime `dim`.
+template <int D>
+void solve_rows(int dim, const double* u, const double* inverse, int m, const double* b, double* w) {
+  const int d = D > 0 ? D : dim;
   int q = 0;
   // Eight columns at a time, their two quads in registers down all d rows.
   for (; q + 8 <= m; q += 8) {
+#pragma GCC unroll 16
     for (int i = 0; i < d; ++i) {
       const double* ui = u + d * i;  // column i of U: U_pi for p <= i
       const double* bi = b + i * m + q;
       Quad v0 = load(bi), v1 = load(bi + 4);
+#pragma GCC unroll 16
       for (int p = 0; p < i; ++p) {
         const Quad factor = splat(ui[p]);
         const double* wp = w + p * m + q;
@@ -181,6 +192,13 @@ void solve_upper_transposed_rows(int d, const double* u, const double* inverse, 
       w[i * m + q] = v * inverse[i];
     }
   }
+}
+
+}  // namespace
+
+void solve_upper_transposed_rows(int d, const double* u, const double* inverse, int m, const double* b, double* w) {
+  if (d == 8) return solve_rows<8>(d, u, inverse, m, b, w);
+  solve_rows<0>(d, u, inverse, m, b, w);
 }
 
 bool all_finite(const double* v, std::size_t n) {
