@@ -136,15 +136,35 @@ void add_transposed_times_vector(int depth, int cols, const double* x, int ldx, 
     store(out + c + 8, load(out + c + 8) + s * s2);
     store(out + c + 12, load(out + c + 12) + s * s3);
   }
+  // Eight: two sums, one broadcast of v[k] for both (a factor's runs are
+  // mostly 8 to 12 columns wide).
+  for (; c + 8 <= cols; c += 8) {
+    Quad s0 = {}, s1 = {};
+#pragma GCC unroll 4
+    for (int k = 0; k < depth; ++k) {
+      const double* xk = x + k * ldx + c;
+      const Quad vk = splat(v[k]);
+      s0 += load(xk) * vk;
+      s1 += load(xk + 4) * vk;
+    }
+    const Quad s = splat(sign);
+    store(out + c, load(out + c) + s * s0);
+    store(out + c + 4, load(out + c + 4) + s * s1);
+  }
   for (; c + 4 <= cols; c += 4) {
     Quad sum = {};
+#pragma GCC unroll 4
     for (int k = 0; k < depth; ++k) sum += load(x + k * ldx + c) * splat(v[k]);
     store(out + c, load(out + c) + splat(sign) * sum);
   }
-  // The last three columns or fewer by the portable kernel (compiled
-  // without AVX: a call across the boundary is safe, unlike a shared inline
-  // helper).
-  if (c < cols) add_transposed_times_vector_portable(depth, cols - c, x + c, ldx, v, sign, out + c);
+  // The last three columns or fewer, each its own sum down the depth (as
+  // the portable kernel's pairs and single column: the same bits), here
+  // rather than by a call.
+  for (; c < cols; ++c) {
+    double sum = 0.0;
+    for (int k = 0; k < depth; ++k) sum += x[k * ldx + c] * v[k];
+    out[c] += sign * sum;
+  }
 }
 
 namespace {
