@@ -28,6 +28,7 @@ Quad splat(double a) { return Quad{a, a, a, a}; }
 // arrays of vectors in memory).
 void tile8x4(int depth, const double* x, int ldx, const double* y, int ldy, double* out, int ldo, double sign) {
   Quad a0 = {}, a1 = {}, a2 = {}, a3 = {}, b0 = {}, b1 = {}, b2 = {}, b3 = {};
+#pragma GCC unroll 4
   for (int k = 0; k < depth; ++k) {
     const double* xk = x + k * ldx;
     const double* yk = y + k * ldy;
@@ -58,6 +59,7 @@ void tile8x4(int depth, const double* x, int ldx, const double* y, int ldy, doub
 template <int Cols>
 void tile4(int depth, const double* x, int ldx, const double* y, int ldy, double* out, int ldo, double sign) {
   Quad a0 = {}, a1 = {}, a2 = {}, a3 = {};
+#pragma GCC unroll 4
   for (int k = 0; k < depth; ++k) {
     const Quad xv = load(x + k * ldx);
     const double* yk = y + k * ldy;
@@ -134,25 +136,54 @@ void add_transposed_times_vector(int depth, int cols, const double* x, int ldx, 
     store(out + c + 8, load(out + c + 8) + s * s2);
     store(out + c + 12, load(out + c + 12) + s * s3);
   }
+  // Eight: two sums, one broadcast of v[k] for both (a factor's runs are
+  // mostly 8 to 12 columns wide).
+  for (; c + 8 <= cols; c += 8) {
+    Quad s0 = {}, s1 = {};
+#pragma GCC unroll 4
+    for (int k = 0; k < depth; ++k) {
+      const double* xk = x + k * ldx + c;
+      const Quad vk = splat(v[k]);
+      s0 += load(xk) * vk;
+      s1 += load(xk + 4) * vk;
+    }
+    const Quad s = splat(sign);
+    store(out + c, load(out + c) + s * s0);
+    store(out + c + 4, load(out + c + 4) + s * s1);
+  }
   for (; c + 4 <= cols; c += 4) {
     Quad sum = {};
+#pragma GCC unroll 4
     for (int k = 0; k < depth; ++k) sum += load(x + k * ldx + c) * splat(v[k]);
     store(out + c, load(out + c) + splat(sign) * sum);
   }
-  // The last three columns or fewer by the portable kernel (compiled
-  // without AVX: a call across the boundary is safe, unlike a shared inline
-  // helper).
-  if (c < cols) add_transposed_times_vector_portable(depth, cols - c, x + c, ldx, v, sign, out + c);
+  // The last three columns or fewer, each its own sum down the depth (as
+  // the portable kernel's pairs and single column: the same bits), here
+  // rather than by a call.
+  for (; c < cols; ++c) {
+    double sum = 0.0;
+    for (int k = 0; k < depth; ++k) sum += x[k * ldx + c] * v[k];
+    out[c] += sign * sum;
+  }
 }
 
-void solve_upper_transposed_rows(int d, const double* u, const double* inverse, int m, const double* b, double* w) {
+namespace {
+
+// solve_upper_transposed_rows for d = D when D > 0 (known at compile time, the
+// row loops unroll completely: a pose group's d = 8 leaves no loop control
+// in the substitution), else the runtime `dim`.
+template <int D>
+void solve_rows(int dim, const double* u, const double* inverse, int m, const double* b, double* w) {
+  const int d = D > 0 ? D : dim;
   int q = 0;
   // Eight columns at a time, their two quads in registers down all d rows.
   for (; q + 8 <= m; q += 8) {
+#pragma GCC unroll 16
     for (int i = 0; i < d; ++i) {
       const double* ui = u + d * i;  // column i of U: U_pi for p <= i
       const double* bi = b + i * m + q;
       Quad v0 = load(bi), v1 = load(bi + 4);
+#pragma GCC unroll 16
       for (int p = 0; p < i; ++p) {
         const Quad factor = splat(ui[p]);
         const double* wp = w + p * m + q;
@@ -181,6 +212,13 @@ void solve_upper_transposed_rows(int d, const double* u, const double* inverse, 
       w[i * m + q] = v * inverse[i];
     }
   }
+}
+
+}  // namespace
+
+void solve_upper_transposed_rows(int d, const double* u, const double* inverse, int m, const double* b, double* w) {
+  if (d == 8) return solve_rows<8>(d, u, inverse, m, b, w);
+  solve_rows<0>(d, u, inverse, m, b, w);
 }
 
 bool all_finite(const double* v, std::size_t n) {

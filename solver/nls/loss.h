@@ -51,6 +51,8 @@ struct Loss {
   bool quadratic_at(double r) const {
     return shared ? shared->quadratic_at(r) : LossFunction{LossKind::kHuber, huber_width}.quadratic_at(r);
   }
+  // Quadratic at every residual: plain least squares, not shared.
+  bool least_squares() const { return !shared && !(huber_width > 0.0); }
 };
 
 }  // namespace cdpr

@@ -162,7 +162,7 @@ TEST(DenseKernels, Avx2VectorProductAndSubstitutionGiveThePortableBits) {
   if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this processor has no AVX2";
   std::mt19937 rng(8);
   for (int depth : {0, 1, 7, 9}) {
-    for (int cols = 1; cols <= 37; ++cols) {  // blocks of sixteen, quads and single columns
+    for (int cols = 1; cols <= 37; ++cols) {  // blocks of sixteen, eight, quads and single columns
       const RowMajor x = random_matrix(depth, cols + 1, rng);
       const Eigen::VectorXd v = Eigen::VectorXd::Random(depth);
       const Eigen::VectorXd start = Eigen::VectorXd::Random(cols);

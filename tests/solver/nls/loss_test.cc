@@ -1,9 +1,13 @@
 #include "solver/nls/loss.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstring>
 
 #include <gtest/gtest.h>
+
+#include "solver/nls/factor_support.h"
 
 namespace cdpr {
 namespace {
@@ -89,6 +93,36 @@ TEST(Loss, QuadraticWhereItLeavesTheResidualAsLeastSquares) {
   EXPECT_TRUE(Loss{0.0}.quadratic_at(1e6));
   EXPECT_FALSE(Loss{2.0}.quadratic_at(2.5));
   EXPECT_TRUE((Loss{0.0, &huber}.quadratic_at(1.5)));
+}
+
+TEST(Loss, LeastSquaresEverywhereOnlyWithoutWidthOrSharedFunction) {
+  const LossFunction squared{};
+  EXPECT_TRUE(Loss{0.0}.least_squares());
+  EXPECT_TRUE(Loss{-1.0}.least_squares());
+  EXPECT_FALSE(Loss{2.0}.least_squares());
+  // a shared function may change between evaluations
+  EXPECT_FALSE((Loss{0.0, &squared}.least_squares()));
+}
+
+TEST(Loss, ApplyLossOfLeastSquaresGivesTheRowByRowBits) {
+  // GIVEN residuals and a Jacobian block, once under a plain Loss and once
+  // under a shared least-squares function (asked row by row)
+  const LossFunction squared{};
+  const std::array<double, 4> start = {0.3, -1e5, 2.0 / 3.0, 0.0};
+  std::array<double, 4> plain = start, shared = start;
+  std::array<double, 8> plain_jacobian{}, shared_jacobian{};
+  for (std::size_t i = 0; i < plain_jacobian.size(); ++i) plain_jacobian[i] = shared_jacobian[i] = 0.1 * i - 0.3;
+  double* plain_blocks[] = {plain_jacobian.data()};
+  double* shared_blocks[] = {shared_jacobian.data()};
+  const std::array<int, 1> dims = {2};
+  // WHEN the loss is applied
+  const double plain_cost = apply_loss(Loss{0.0}, 4, plain.data(), plain_blocks, dims);
+  const double shared_cost = apply_loss(Loss{0.0, &squared}, 4, shared.data(), shared_blocks, dims);
+  // THEN the costs, residuals and rows are the same bits
+  EXPECT_EQ(std::memcmp(&plain_cost, &shared_cost, sizeof(double)), 0);
+  EXPECT_EQ(plain, shared);
+  EXPECT_EQ(plain, start);
+  EXPECT_EQ(plain_jacobian, shared_jacobian);
 }
 
 }  // namespace
