@@ -170,7 +170,7 @@ EquilibriumCheck EquilibriumDetector::check() const {
   const bool slow = result.speed_mps <= thresholds_.max_speed_mps &&
                     result.angular_rate_radps <= thresholds_.max_angular_rate_radps;
   ReturnTest returned;
-  if (covered && slow) returned = return_beyond_noise(begin, span / kRateBins);
+  if (covered && slow) returned = return_beyond_noise(begin, std::min(span / kRateBins, 1e6 * kMaxReturnBinS));
   result.return_m = returned.excess_m;
   if (!covered) {
     result.verdict = EquilibriumVerdict::kNotEnoughData;

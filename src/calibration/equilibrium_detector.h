@@ -28,8 +28,8 @@
 //    motion;
 //  - the platform did not come back to where it is: the return window (the
 //    last sway_window_us, at least twice the rest window's span) is covered
-//    (kNotEnoughData before), and, cut into bins as long as the rate bins,
-//    no bin in it is farther from the rest window's mean position than an
+//    (kNotEnoughData before), and, cut into bins as long as the rate bins
+//    but at most kMaxReturnBinS, no bin in it is farther from the rest window's mean position than an
 //    earlier bin by more than kNoiseAllowance standard errors of the two
 //    bin means (kSwaying otherwise).
 // The rates bound how fast the platform moves, not how far it is from its
@@ -41,7 +41,10 @@
 // point one period earlier and up to 2 A away in between. So the return
 // test finds a sway of any period shorter than the return window once its
 // amplitude is above the noise of a bin mean, and leaves a monotone
-// approach to the rate limits. It needs no period and no fit, but it needs
+// approach to the rate limits. Its bins are short against the sway
+// periods it is for (a bin as long as a period averages the sway away: the
+// rate bins of a rest window of min_samples sparse poses can be 10 s).
+// It needs no period and no fit, but it needs
 // the history: a turning point seen for less than a period looks like a
 // platform coming to rest, so a platform at rest settles once the return
 // window is covered (with estimate_sway, the sway fit needs that window
@@ -186,7 +189,10 @@ class EquilibriumDetector {
   // the position and rotation axes): noise alone, even at the best of the
   // searched periods, stays far below.
   static constexpr double kMinSwaySignificance = 100.0;
-  static constexpr int kSwayBins = 200;  // bin means of the grid search
+  static constexpr int kSwayBins = 200;  // bin means of the grid search (and the return test)
+  // Longest bin of the return test [s, source time]: a fifth of the
+  // shortest sway period it is meant for (5 s).
+  static constexpr double kMaxReturnBinS = 1.0;
 
   // capacity >= 2: the most observations kept (see above).
   EquilibriumDetector(const EquilibriumThresholds& thresholds, std::size_t capacity);
