@@ -29,9 +29,10 @@
 //  - the platform did not come back to where it is: the return window (the
 //    last sway_window_us, at least twice the rest window's span) is covered
 //    (kNotEnoughData before), and, cut into bins as long as the rate bins
-//    but at most kMaxReturnBinS, no bin in it is farther from the rest window's mean position than an
-//    earlier bin by more than kNoiseAllowance standard errors of the two
-//    bin means (kSwaying otherwise).
+//    but at most kMaxReturnBinS, no bin in it is farther from the rest
+//    window's mean position than an earlier bin by more than
+//    kNoiseAllowance standard errors of the two bin means (kSwaying
+//    otherwise).
 // The rates bound how fast the platform moves, not how far it is from its
 // rest: a sway of period T and amplitude A is slow at its turning points,
 // where it is A from rest, and over a window short against T the rate
@@ -43,11 +44,10 @@
 // amplitude is above the noise of a bin mean, and leaves a monotone
 // approach to the rate limits. Its bins are short against the sway
 // periods it is for (a bin as long as a period averages the sway away: the
-// rate bins of a rest window of min_samples sparse poses can be 10 s).
-// It needs no period and no fit, but it needs
-// the history: a turning point seen for less than a period looks like a
-// platform coming to rest, so a platform at rest settles once the return
-// window is covered (with estimate_sway, the sway fit needs that window
+// rate bins of a rest window of min_samples sparse poses can be 10 s). It
+// needs no period and no fit, but it needs the history: a turning point
+// seen for less than a period looks like a platform coming to rest, so a
+// platform at rest settles once the return window is covered (with estimate_sway, the sway fit needs that window
 // too, and a slow window is tried as a sway before it is covered). Only
 // the position is tested: a sway moves the platform's origin with its
 // rotation.
@@ -95,7 +95,7 @@
 // check(), average() and average_sigmas() never allocate. When more than
 // `capacity` observations fall in the window the oldest are dropped and the
 // window can never be covered: size capacity >= the longer of window_us and
-// sway_window_us x sample rate (+ margin).
+// sway_window_us x sample rate, and >= 2 min_samples (+ margin).
 // Time is passed in with each observation ([us], the source's stamp); time
 // going backwards resets the window.
 // Not thread-safe.
