@@ -21,6 +21,7 @@ const char* to_string(EquilibriumVerdict verdict) {
     case EquilibriumVerdict::kTensionSpread: return "tension varies";
     case EquilibriumVerdict::kMoving: return "platform moving";
     case EquilibriumVerdict::kRotating: return "platform rotating";
+    case EquilibriumVerdict::kSwaying: return "platform swaying";
     case EquilibriumVerdict::kSettled: return "settled";
     case EquilibriumVerdict::kSwayEstimated: return "rest estimated from the sway";
   }
@@ -58,11 +59,10 @@ void EquilibriumDetector::add(const EquilibriumObservation& observation) {
   ++added_;
   // Keep exactly one observation at or before the start of the longer of
   // the rest and the sway window, so a full window is recognisable by its
-  // span, and at least min_samples.
-  const hal::TimeUs window_start_us =
-      observation.time_us -
-      (thresholds_.estimate_sway ? std::max(thresholds_.window_us, thresholds_.sway_window_us) : thresholds_.window_us);
-  const std::size_t keep = static_cast<std::size_t>(std::max({2, thresholds_.min_samples, kRateBins}));
+  // span, and at least twice the rest window's observations (the return
+  // test's history when poses are sparse in source time).
+  const hal::TimeUs window_start_us = observation.time_us - std::max(thresholds_.window_us, thresholds_.sway_window_us);
+  const std::size_t keep = 2 * static_cast<std::size_t>(std::max({2, thresholds_.min_samples, kRateBins}));
   while (count_ > keep && at(1).time_us <= window_start_us) {
     first_ = (first_ + 1) % ring_.size();
     --count_;
@@ -167,6 +167,11 @@ EquilibriumCheck EquilibriumDetector::check() const {
 
   const bool covered = result.span_us >= thresholds_.window_us &&
                        result.samples >= std::max(thresholds_.min_samples, kRateBins) && bins_filled;
+  const bool slow = result.speed_mps <= thresholds_.max_speed_mps &&
+                    result.angular_rate_radps <= thresholds_.max_angular_rate_radps;
+  ReturnTest returned;
+  if (covered && slow) returned = return_beyond_noise(begin, std::min(span / kRateBins, 1e6 * kMaxReturnBinS));
+  result.return_m = returned.excess_m;
   if (!covered) {
     result.verdict = EquilibriumVerdict::kNotEnoughData;
   } else if (!all_stable) {
@@ -177,13 +182,18 @@ EquilibriumCheck EquilibriumDetector::check() const {
     result.verdict = EquilibriumVerdict::kMoving;
   } else if (!(result.angular_rate_radps <= thresholds_.max_angular_rate_radps)) {
     result.verdict = EquilibriumVerdict::kRotating;
+  } else if (!returned.covered) {
+    result.verdict = EquilibriumVerdict::kNotEnoughData;
+  } else if (result.return_m > 0.0) {
+    result.verdict = EquilibriumVerdict::kSwaying;
   } else {
     result.verdict = EquilibriumVerdict::kSettled;
   }
   // Only a platform seen moving is tried as a sway: one at rest whose load
   // cell is not stable or whose tension varies stays refused.
-  const bool moving = !(result.speed_mps <= thresholds_.max_speed_mps) ||
-                      !(result.angular_rate_radps <= thresholds_.max_angular_rate_radps);
+  // A slow window whose return window is not covered yet may be a sway's
+  // turning point: the fit decides.
+  const bool moving = !slow || !returned.covered || result.return_m > 0.0;
   if (result.verdict != EquilibriumVerdict::kSettled && result.verdict != EquilibriumVerdict::kNotEnoughData &&
       moving && thresholds_.estimate_sway) {
     fit_sway();
@@ -195,6 +205,50 @@ EquilibriumCheck EquilibriumDetector::check() const {
     }
   }
   return result;
+}
+
+EquilibriumDetector::ReturnTest EquilibriumDetector::return_beyond_noise(std::size_t rest_begin, double bin_us) const {
+  // The return window: the last sway_window_us, at least twice the rest
+  // window, cut into bins as long as the rate bins.
+  ReturnTest out;
+  const hal::TimeUs newest_us = at(count_ - 1).time_us;
+  const hal::TimeUs length_us = std::max(thresholds_.sway_window_us, 2 * (newest_us - at(rest_begin).time_us));
+  std::size_t begin = 0;
+  while (begin + 1 < count_ && at(begin + 1).time_us <= newest_us - length_us) ++begin;
+  const hal::TimeUs t0_us = at(begin).time_us;
+  out.covered = newest_us - t0_us >= length_us;
+  if (!out.covered) return out;
+  const std::size_t rest_count = count_ - rest_begin;
+  const int bin_count = std::clamp(static_cast<int>(static_cast<double>(newest_us - t0_us) / std::max(bin_us, 1.0)) + 1,
+                                   1, static_cast<int>(bins_.size()));
+  const double width_us = std::max(static_cast<double>(newest_us - t0_us) / bin_count, 1.0);
+  const Eigen::Vector3d origin = at(begin).position_world;
+  bins_.assign(bins_.size(), {0.0, 0.0, 0.0, 0.0, 0.0});
+  Eigen::Vector3d rest_sum = Eigen::Vector3d::Zero(), step_square = Eigen::Vector3d::Zero();
+  for (std::size_t k = begin; k < count_; ++k) {
+    const Eigen::Vector3d p = at(k).position_world - origin;
+    const int b = std::min(bin_count - 1, static_cast<int>(static_cast<double>(at(k).time_us - t0_us) / width_us));
+    for (int axis = 0; axis < 3; ++axis) bins_[b][1 + axis] += p(axis);
+    bins_[b][4] += 1.0;
+    if (k >= rest_begin) rest_sum += p;
+    if (k > begin) step_square += (p - (at(k - 1).position_world - origin)).cwiseAbs2();
+  }
+  const Eigen::Vector3d rest = rest_sum / static_cast<double>(rest_count);
+  // Noise variance of one observation, summed over the axes.
+  const double noise_var = step_square.sum() / (2.0 * static_cast<double>(count_ - begin - 1));
+  // Each bin's distance from the rest window's mean; a later bin farther
+  // than an earlier one, beyond the noise of the two bin means, is a return.
+  for (int k = 0; k < bin_count; ++k) {
+    if (bins_[k][4] == 0.0) continue;
+    const double dk = (Eigen::Vector3d(bins_[k][1], bins_[k][2], bins_[k][3]) / bins_[k][4] - rest).norm();
+    for (int j = 0; j < k; ++j) {
+      if (bins_[j][4] == 0.0) continue;
+      const double dj = (Eigen::Vector3d(bins_[j][1], bins_[j][2], bins_[j][3]) / bins_[j][4] - rest).norm();
+      const double noise = kNoiseAllowance * std::sqrt(noise_var * (1.0 / bins_[j][4] + 1.0 / bins_[k][4]));
+      out.excess_m = std::max(out.excess_m, dk - dj - noise);
+    }
+  }
+  return out;
 }
 
 double EquilibriumDetector::coordinate(const EquilibriumObservation& o, int c, const Eigen::Quaterniond& mean_q) const {

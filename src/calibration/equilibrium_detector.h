@@ -25,7 +25,32 @@
 //    change counts only by what exceeds kNoiseAllowance times its own
 //    standard error (the noise from successive differences of the
 //    observations), so a noisy pose source at a low rate does not read as
-//    motion.
+//    motion;
+//  - the platform did not come back to where it is: the return window (the
+//    last sway_window_us, at least twice the rest window's span) is covered
+//    (kNotEnoughData before), and, cut into bins as long as the rate bins
+//    but at most kMaxReturnBinS, no bin in it is farther from the rest
+//    window's mean position than an earlier bin by more than
+//    kNoiseAllowance standard errors of the two bin means (kSwaying
+//    otherwise).
+// The rates bound how fast the platform moves, not how far it is from its
+// rest: a sway of period T and amplitude A is slow at its turning points,
+// where it is A from rest, and over a window short against T the rate
+// limits (and their noise allowance) pass it for A of centimetres. A
+// platform approaching rest without overshoot is the farther from where it
+// is now the further back one looks; a swaying one was near its turning
+// point one period earlier and up to 2 A away in between. So the return
+// test finds a sway of any period shorter than the return window once its
+// amplitude is above the noise of a bin mean, and leaves a monotone
+// approach to the rate limits. Its bins are short against the sway
+// periods it is for (a bin as long as a period averages the sway away: the
+// rate bins of a rest window of min_samples sparse poses can be 10 s). It
+// needs no period and no fit, but it needs the history: a turning point
+// seen for less than a period looks like a platform coming to rest, so a
+// platform at rest settles once the return window is covered (with estimate_sway, the sway fit needs that window
+// too, and a slow window is tried as a sway before it is covered). Only
+// the position is tested: a sway moves the platform's origin with its
+// rotation.
 // One observation under a threshold is never enough (docs/STYLE.md).
 //
 // A platform on long cables sways after a move with a period of seconds and
@@ -70,7 +95,7 @@
 // check(), average() and average_sigmas() never allocate. When more than
 // `capacity` observations fall in the window the oldest are dropped and the
 // window can never be covered: size capacity >= the longer of window_us and
-// sway_window_us x sample rate (+ margin).
+// sway_window_us x sample rate, and >= 2 min_samples (+ margin).
 // Time is passed in with each observation ([us], the source's stamp); time
 // going backwards resets the window.
 // Not thread-safe.
@@ -118,6 +143,7 @@ enum class EquilibriumVerdict {
   kTensionSpread,   // tension standard deviation too large
   kMoving,          // speed too large
   kRotating,        // angular rate too large
+  kSwaying,         // slow in the rest window, but the platform came back to it (see above)
   kSettled,
   kSwayEstimated,   // not at rest, but a sway about a rest state that the fit estimates
 };
@@ -141,6 +167,7 @@ struct EquilibriumCheck {
   double speed_mps = 0.0;            // measured as described above, noise allowance taken off
   double angular_rate_radps = 0.0;
   double tension_std_n = 0.0;
+  double return_m = 0.0;             // the return test's largest excess over the noise [m], 0 when none
   double sway_period_s = 0.0;        // of the last sway fit, 0 without one
   double sway_misfit = 0.0;          // its largest residual / noise variance
   bool settled() const {
@@ -162,7 +189,10 @@ class EquilibriumDetector {
   // the position and rotation axes): noise alone, even at the best of the
   // searched periods, stays far below.
   static constexpr double kMinSwaySignificance = 100.0;
-  static constexpr int kSwayBins = 200;  // bin means of the grid search
+  static constexpr int kSwayBins = 200;  // bin means of the grid search (and the return test)
+  // Longest bin of the return test [s, source time]: a fifth of the
+  // shortest sway period it is meant for (5 s).
+  static constexpr double kMaxReturnBinS = 1.0;
 
   // capacity >= 2: the most observations kept (see above).
   EquilibriumDetector(const EquilibriumThresholds& thresholds, std::size_t capacity);
@@ -208,6 +238,14 @@ class EquilibriumDetector {
   // Fits the sway window (see above) into sway_, unless fitted recently.
   void fit_sway() const;
   double sway_residual_sum(double omega, double decay) const;
+  // The return test (see above) of the rest window starting at rest_begin,
+  // with bins of bin_us: whether the return window is covered and, if so,
+  // the largest excess [m] of a return over the noise, 0 when none.
+  struct ReturnTest {
+    bool covered = false;
+    double excess_m = 0.0;
+  };
+  ReturnTest return_beyond_noise(std::size_t rest_begin, double bin_us) const;
 
   EquilibriumThresholds thresholds_;
   std::vector<EquilibriumObservation> ring_;

@@ -39,6 +39,9 @@ inline CalibratorOptions rig_options() {
   options.planner.z_max_m = 35.0;
   options.equilibrium.window_us = 1'000'000;
   options.equilibrium.min_samples = 20;
+  // The fake platform does not sway: the shortest return window (twice the
+  // rest window) keeps a waypoint's settle at two seconds.
+  options.equilibrium.sway_window_us = 2'000'000;
   options.equilibrium_capacity = 200;
   options.validation.min_samples = 4;
   options.settle_timeout_us = 10'000'000;
