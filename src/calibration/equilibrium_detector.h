@@ -100,6 +100,7 @@
 // going backwards resets the window.
 // Not thread-safe.
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <vector>
@@ -150,13 +151,19 @@ enum class EquilibriumVerdict {
 
 const char* to_string(EquilibriumVerdict verdict);
 
+// The return test's window at full rate (see above): the least a waypoint
+// waits before any verdict settles, whatever the detector.
+inline hal::TimeUs return_window_us(const EquilibriumThresholds& t) {
+  return std::max(t.sway_window_us, 2 * t.window_us);
+}
+
 // The robot time [s] a waypoint is expected to wait before its sample, for
-// planning: a move excites sway, so with the sway estimate on the sample
-// comes when the sway window is full; waiting for rest is modelled by the
-// rest window alone (optimistic for a platform that sways).
+// planning: a move excites sway and nothing settles before the return
+// window is covered, when the sway estimate takes its sample; waiting for
+// rest is modelled by that window alone (optimistic for a platform that
+// sways).
 inline double expected_settle_s(const EquilibriumThresholds& t) {
-  const hal::TimeUs wait_us = t.estimate_sway && t.sway_window_us > t.window_us ? t.sway_window_us : t.window_us;
-  return 1e-6 * static_cast<double>(wait_us);
+  return 1e-6 * static_cast<double>(return_window_us(t));
 }
 
 // The verdict and the measured values behind it (for the status line).

@@ -167,7 +167,8 @@ Table<CalibratorOptions> equilibrium_table() {
             "a platform still swaying is fitted as a decaying oscillation about its rest, and the fitted rest is "
             "the sample; false: wait until it is at rest");
   t.duration("sway_window_s", [](auto& o) -> auto& { return o.equilibrium.sway_window_us; }, 40.0, kS,
-             "the sway fit's window in the pose source's own time, >= 1.5 sway periods");
+             "the sway fit's window in the pose source's own time, >= 1.5 sway periods; also the return test's: "
+             "nothing settles before it is covered (at least twice window_s)");
   t.number("max_sway_misfit", [](auto& o) -> auto& { return o.equilibrium.max_sway_misfit; }, 1.5, kPositive, "",
            "largest residual / noise variance of a sway fit: more is not one sway about a rest, and is waited out");
   t.integer("capacity", &CalibratorOptions::equilibrium_capacity,
