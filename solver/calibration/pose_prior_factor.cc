@@ -4,7 +4,7 @@
 
 namespace cdpr {
 namespace {
-constexpr std::array<int, 1> kBlockDims = {6};
+constexpr std::array<int, 1> kPosePriorBlockDims = {6};
 }
 
 PosePriorFactor::PosePriorFactor(int pose_index, const Pose& measured, double sigma_position_m,
@@ -29,7 +29,7 @@ bool PosePriorFactor::evaluate(const double* const* parameters, double* residual
     J.topLeftCorner<3, 3>().diagonal().setConstant(1.0 / sigma_position_m_);
     J.bottomRightCorner<3, 3>() = so3_right_jacobian_inverse(rotation_error) / sigma_orientation_rad_;
   }
-  *cost = apply_loss(loss_, 6, residual, jacobians, kBlockDims);
+  *cost = apply_loss(loss_, 6, residual, jacobians, kPosePriorBlockDims);
   return true;
 }
 

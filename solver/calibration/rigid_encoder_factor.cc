@@ -4,7 +4,7 @@
 
 namespace cdpr {
 namespace {
-constexpr std::array<int, 3> kBlockDims = {6, 3, 1};
+constexpr std::array<int, 3> kRigidEncoderBlockDims = {6, 3, 1};
 }
 
 RigidEncoderFactor::RigidEncoderFactor(int pose_index, int cable, const Eigen::Vector3d& attachment_platform,
@@ -38,7 +38,7 @@ bool RigidEncoderFactor::evaluate(const double* const* parameters, double* resid
     }
     if (jacobians[2]) jacobians[2][0] = 1.0 / sigma_encoder_m_;
   }
-  *cost = apply_loss(loss_, 1, residual, jacobians, kBlockDims);
+  *cost = apply_loss(loss_, 1, residual, jacobians, kRigidEncoderBlockDims);
   return true;
 }
 

@@ -11,7 +11,7 @@ namespace cdpr {
 namespace {
 
 // Tangent sizes of the variables, in keys() order.
-constexpr std::array<int, StaticPoseFactor::kKeyCount> kBlockDims = {6, 2, 3, 3, 3, 3, 1, 1, 1, 1};
+constexpr std::array<int, StaticPoseFactor::kKeyCount> kStaticPoseBlockDims = {6, 2, 3, 3, 3, 3, 1, 1, 1, 1};
 
 // One residual row's derivative as the chain rule through a cable's catenary
 // inputs: sum_k weight[k] * (d f_h, d f_v, d span, d anchor_z)[k], each a
@@ -137,8 +137,8 @@ bool StaticPoseFactor::evaluate(const double* const* parameters, double* residua
         tension > 0.0 ? Eigen::Vector2d(in.reference_force / (tension * sigma_force)) : Eigen::Vector2d::Zero();
     write_force_row(d_force, force_row, jacobians);
   }
-  zero_rows(std::span(left_out_.rows.data(), left_out_.count), residual, jacobians, kBlockDims);
-  *cost = apply_loss_to_rows(loss_, kReadingRows, kResidualDim, residual, jacobians, kBlockDims);
+  zero_rows(std::span(left_out_.rows.data(), left_out_.count), residual, jacobians, kStaticPoseBlockDims);
+  *cost = apply_loss_to_rows(loss_, kReadingRows, kResidualDim, residual, jacobians, kStaticPoseBlockDims);
   return true;
 }
 

@@ -52,6 +52,7 @@ inline constexpr NumberRange kNonZero{-std::numeric_limits<double>::infinity(),
 
 // The unit a duration key is written in (its name ends in _ms or _s); held in microseconds.
 enum class TimeUnit { kMilliseconds, kSeconds };
+inline constexpr TimeUnit kMs = TimeUnit::kMilliseconds;
 
 // An integer default, or one counted up per table of an array ([[winches.winch]]: node 1, 2, 3, 4).
 struct IntDefault {

@@ -16,7 +16,6 @@ using calibration::PlannerOptions;
 using calibration::ValidationLimits;
 using drivers::can::CanWinchConfig;
 using formats::TomlReader;
-constexpr TimeUnit kMs = TimeUnit::kMilliseconds;
 constexpr TimeUnit kS = TimeUnit::kSeconds;
 
 // What getgrnam() can be asked for and chown() given: a portable group name

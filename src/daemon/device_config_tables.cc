@@ -12,7 +12,6 @@ using drivers::modbus::ByteOrder;
 using drivers::modbus::ForceUnit;
 using drivers::modbus::RegisterKind;
 using drivers::modbus::ValueType;
-constexpr TimeUnit kMs = TimeUnit::kMilliseconds;
 constexpr IntRange kNodeId{1, 127};
 constexpr IntRange kUnsigned32{0, 0xFFFFFFFFll, true};
 constexpr IntRange kRegister{0, 65535};

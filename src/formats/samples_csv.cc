@@ -57,7 +57,7 @@ std::string joined(const std::vector<std::string>& names) {
 
 std::string quoted(std::string_view text) { return "'" + std::string(text) + "'"; }
 
-std::string number_text(double value) {
+std::string csv_number_text(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "%.6g", value);
   return text;
@@ -190,7 +190,7 @@ Expected<Sample, FormatError> parse_row(const TextLine& line, const Header& head
   const double norm = sample.world_R_platform.norm();
   if (std::abs(norm - 1.0) > kUnitTolerance) {
     return fail("qw..qz",
-                "quaternion norm " + number_text(norm) + " is not 1 (tolerance " + number_text(kUnitTolerance) + ")");
+                "quaternion norm " + csv_number_text(norm) + " is not 1 (tolerance " + csv_number_text(kUnitTolerance) + ")");
   }
   if (std::abs(norm - 1.0) > kAlreadyUnit) sample.world_R_platform.normalize();
   for (int i = 0; i < kCableCount; ++i) sample.encoder_m[i] = values[static_cast<std::size_t>(kFirstEncoder + i)];

@@ -19,6 +19,7 @@
 #include "src/formats/calibration_toml.h"
 #include "src/formats/robot_toml.h"
 #include "src/formats/samples_csv.h"
+#include "../read_text.h"
 #include "virtual_robot_process.h"
 
 namespace cdpr::integration {
@@ -26,12 +27,7 @@ namespace {
 
 using namespace std::chrono_literals;
 
-std::string read_text(const std::string& path) {
-  std::ifstream file(path);
-  std::stringstream text;
-  text << file.rdbuf();
-  return text.str();
-}
+using cdpr::test::read_text;
 
 int data_rows(const std::string& samples_csv) {
   std::ifstream file(samples_csv);

@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "src/formats/calibration_toml.h"
+#include "../read_text.h"
 #include "virtual_robot_rig.h"
 
 namespace cdpr::integration {
@@ -40,12 +41,7 @@ namespace {
 constexpr int kServiceId = 4242;    // the unit's User= and Group=, cdpr-calib
 constexpr int kOperatorsId = 4343;  // a group the unit does not run as
 
-std::string read_text(const std::string& path) {
-  std::ifstream file(path);
-  std::stringstream text;
-  text << file.rdbuf();
-  return text.str();
-}
+using cdpr::test::read_text;
 
 // Why the kernel cannot give the sandbox (empty: it can). A missing
 // bubblewrap is not a reason: `make deps` installs it.

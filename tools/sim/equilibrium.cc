@@ -15,8 +15,6 @@ namespace {
 
 namespace si = state_index;
 
-EquilibriumFailure failure(EquilibriumError code, std::string message) { return {code, std::move(message)}; }
-
 // The unknowns of each problem: all Newton unknowns, and per cable the three
 // that the projection solves for (see newton()).
 struct Unknowns {

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <string>
+#include <utility>
 
 #include <Eigen/Core>
 
@@ -55,5 +56,8 @@ struct EquilibriumFailure {
   EquilibriumError code = EquilibriumError::kNoConvergence;
   std::string message;
 };
+
+// A failure of the given kind, saying why.
+inline EquilibriumFailure failure(EquilibriumError code, std::string message) { return {code, std::move(message)}; }
 
 }  // namespace cdpr::sim

@@ -11,8 +11,6 @@ namespace {
 
 namespace si = state_index;
 
-EquilibriumFailure failure(EquilibriumError code, std::string message) { return {code, std::move(message)}; }
-
 }  // namespace
 
 Expected<State, EquilibriumFailure> initial_state(EquilibriumModel& model, const Eigen::Vector3d& position_world,

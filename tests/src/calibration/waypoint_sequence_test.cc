@@ -14,7 +14,7 @@ namespace {
 
 TEST(WaypointSequence, AFailedReSolveFallsBackToTheNextSpreadWaypoint) {
   // GIVEN the sequential strategy on the large robot
-  const Robot robot = test::large_robot();
+  const Robot robot = cdpr::test::large_robot();
   SequentialOptions sequential;
   sequential.max_count = 12;
   sequential.resolve = [](const Robot&, const std::vector<Sample>&, const CalibrationOptions&) {
