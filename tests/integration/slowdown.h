@@ -5,8 +5,9 @@
 // Why it exists: these tests run the daemon against the virtual robot in
 // wall-clock time. The robot's physics runs time_scale times faster than the
 // wall clock, one step per pass of its loop; the daemon's fault timeouts
-// (node silence, stale pose, settling) and the tests' deadlines are wall-clock
-// times. Under ASan + UBSan every thread runs some times slower, so each
+// (node silence, stale pose, load cell, settling), the drives' watch of the daemon's
+// heartbeat (they quick-stop when it pauses longer) and the tests' deadlines
+// are wall-clock times. Under ASan + UBSan every thread runs some times slower, so each
 // physics step spans that much more simulated time (coarser motion between
 // the daemon's commands, through which a cable's tension can dip below the
 // run's limit) and a timeout fires on a thread that is merely slow. The sanitizer build runs

@@ -209,7 +209,9 @@ class SandboxRig {
     if (!control_group.empty()) config << "group = \"" << control_group << "\"\n";
     config << "[winches]\nendpoint = \"" << robot->can_endpoint()
            << "\"\nheartbeat_timeout_ms = " << 3000 * slowdown() << "\n"
-           << "[load_cell]\nendpoint = \"" << robot->modbus_endpoint() << "\"\n"
+           << "[winches.drive]\nconsumer_heartbeat_ms = " << 500 * slowdown() << "\n"
+           << "[load_cell]\nendpoint = \"" << robot->modbus_endpoint() << "\"\nfault_timeout_ms = "
+           << 1000 * slowdown() << "\n"
            << "[pose]\nendpoint = \"" << robot->pose_endpoint() << "\"\n"
            << "[button]\nkind = \"none\"\n"
            << "[limits]\nsettle_timeout_s = " << 15 * slowdown() << ".0\npose_stale_ms = " << 3000 * slowdown() << "\n";

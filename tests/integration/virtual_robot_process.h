@@ -50,8 +50,10 @@ class VirtualRobotProcess {
     std::ofstream(config) << "robot = \"" << dir << "/robot/robot.toml\"\n[store]\nstate_dir = \"" << state_dir
                           << "\"\n[control]\nsocket = \"" << socket << "\"\n[winches]\nendpoint = \"unix:" << dir
                           << "/robot/can.sock\"\nheartbeat_timeout_ms = " << 3000 * slowdown()
+                          << "\n[winches.drive]\nconsumer_heartbeat_ms = " << 500 * slowdown()
                           << "\n[load_cell]\nendpoint = "
-                          << "\"tcp:127.0.0.1:" << ready_value("modbus_port") << "\"\n[pose]\nendpoint = \"unix:"
+                          << "\"tcp:127.0.0.1:" << ready_value("modbus_port")
+                          << "\"\nfault_timeout_ms = " << 1000 * slowdown() << "\n[pose]\nendpoint = \"unix:"
                           << dir << "/robot/pose.sock\"\n[button]\nkind = \"none\"\n[limits]\n"
                           << (small ? "min_tension = 0.5\nmax_tension = 300.0\n" : "")
                           << "pose_stale_ms = " << 3000 * slowdown() << "\nsettle_timeout_s = " << 15 * slowdown()

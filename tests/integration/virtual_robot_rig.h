@@ -69,6 +69,7 @@ inline daemon::DaemonConfig fast_daemon_config(const std::string& dir, const vir
   config.winches.max_speed_mps = 5.0 * robot.time_scale();
   config.winches.drive.consumer_heartbeat_us = slowed_us(3'000'000);
   config.calibrator.monitor.pose_stale_us = slowed_us(3'000'000);
+  config.load_cell.fault_timeout_us = slowed_us(config.load_cell.fault_timeout_us);
   return config;
 }
 
