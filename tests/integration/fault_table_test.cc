@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "../src/store/store_test_support.h"
+#include "slowdown.h"
 #include "virtual_robot_rig.h"
 
 namespace cdpr::integration {
@@ -51,15 +52,16 @@ const char* name(DeviceFault fault) {
 }
 
 // The timeouts an operator would configure (tighter than the rig's, which
-// allow for a loaded test machine).
-constexpr hal::TimeUs kLoadCellFaultTimeoutUs = 500'000;
-constexpr hal::TimeUs kPoseStaleUs = 500'000;
+// allow for a loaded test machine). Every time of this test is stretched
+// in the sanitizer build, the robot's physics slowed alike (slowdown.h).
+const hal::TimeUs kLoadCellFaultTimeoutUs = slowed_us(500'000);
+const hal::TimeUs kPoseStaleUs = slowed_us(500'000);
 // The master's node-silence limit and the drives' consumer heartbeat time
 // (the shipped defaults; the rig's are looser for a loaded test machine).
-constexpr hal::TimeUs kWinchHeartbeatUs = 500'000;
+const hal::TimeUs kWinchHeartbeatUs = slowed_us(500'000);
 // Longer than a quick stop from the virtual drives' top speed takes.
-constexpr auto kQuickStopBraking = std::chrono::milliseconds(1500);
-constexpr double kStatusLimitMs = 100.0;
+const auto kQuickStopBraking = slowed(std::chrono::milliseconds(1500));
+const double kStatusLimitMs = slowed_ms(100.0);
 
 class FaultTable : public ::testing::TestWithParam<Scenario> {};
 
@@ -108,7 +110,7 @@ TEST_P(FaultTable, TheRunStopsSafelyAndTheDaemonStaysResponsive) {
   // WHEN a run is moving the winches towards its second waypoint
   std::this_thread::sleep_for(std::chrono::seconds(1));
   ASSERT_TRUE(rig.ask("start")["ok"].boolean());
-  const auto give_up = Clock::now() + std::chrono::seconds(60);
+  const auto give_up = Clock::now() + slowed(std::chrono::seconds(60));
   do {
     times.add(timed_status(rig, status));
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -118,7 +120,7 @@ TEST_P(FaultTable, TheRunStopsSafelyAndTheDaemonStaysResponsive) {
   // AND the device fails while the winches move (the move starts once its
   // profiles are written; if it has not within 5 s, the fault comes anyway)
   bool moving = false;
-  const auto move_give_up = Clock::now() + std::chrono::seconds(5);
+  const auto move_give_up = Clock::now() + slowed(std::chrono::seconds(5));
   while (!moving && Clock::now() < move_give_up) {
     std::array<double, kCableCount> before_m{};
     for (int i = 0; i < kCableCount; ++i) before_m[i] = rig.robot->payout_snapshot_m(i);
@@ -138,7 +140,7 @@ TEST_P(FaultTable, TheRunStopsSafelyAndTheDaemonStaysResponsive) {
   do {
     times.add(timed_status(rig, status));
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  } while (status["running"].boolean() && Clock::now() < failed_at + std::chrono::seconds(30));
+  } while (status["running"].boolean() && Clock::now() < failed_at + slowed(std::chrono::seconds(30)));
   const double time_to_fault_ms = std::chrono::duration<double, std::milli>(Clock::now() - failed_at).count();
   ASSERT_EQ(status["state"].string(), "failed");
   // AND the winches stand still from then on (and status keeps answering).
@@ -147,11 +149,11 @@ TEST_P(FaultTable, TheRunStopsSafelyAndTheDaemonStaysResponsive) {
   // master's heartbeat has been missing for their consumer time, then brake.
   const auto still_by = scenario.device == Device::kWinches
                             ? failed_at + std::chrono::microseconds(kWinchHeartbeatUs) + kQuickStopBraking
-                            : Clock::now() + std::chrono::milliseconds(200);
+                            : Clock::now() + slowed(std::chrono::milliseconds(200));
   std::this_thread::sleep_until(std::max(still_by, Clock::now()));
   std::array<double, kCableCount> payout_m{};
   for (int i = 0; i < kCableCount; ++i) payout_m[i] = rig.robot->payout_snapshot_m(i);
-  const auto watch_until = Clock::now() + std::chrono::seconds(1);
+  const auto watch_until = Clock::now() + slowed(std::chrono::seconds(1));
   while (Clock::now() < watch_until) {
     times.add(timed_status(rig, status));
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -176,7 +178,7 @@ TEST_P(FaultTable, TheRunStopsSafelyAndTheDaemonStaysResponsive) {
   // A silent or garbage device is judged by its timeout (plus one Modbus
   // transaction of 3 x 200 ms and the monitor's tolerance of 3 loop steps);
   // a lost connection at once.
-  EXPECT_LT(time_to_fault_ms, 500.0 + 600.0 + 1000.0) << status["reason"].string();
+  EXPECT_LT(time_to_fault_ms, slowed_ms(500.0 + 600.0 + 1000.0)) << status["reason"].string();
 }
 
 INSTANTIATE_TEST_SUITE_P(

@@ -20,6 +20,7 @@
 #include "src/formats/robot_toml.h"
 #include "src/formats/samples_csv.h"
 #include "../read_text.h"
+#include "slowdown.h"
 #include "virtual_robot_process.h"
 
 namespace cdpr::integration {
@@ -55,7 +56,7 @@ calibctl::JsonValue model_check_of_last_run(const VirtualRobotProcess& rig) {
         run = rig.ask("status")["run"];
         return !run["diagnosis"].string().empty();
       },
-      120s);
+      slowed(120s));
   return run;
 }
 
@@ -68,12 +69,12 @@ void expect_effect_named(const std::vector<std::string>& effect_options, const s
   robot_options.insert(robot_options.end(), effect_options.begin(), effect_options.end());
   VirtualRobotProcess rig("large", 20, "", robot_options);
   auto daemon = rig.start_daemon("daemon");
-  ASSERT_TRUE(wait_until([&] { return rig.answers(); }, 30s)) << daemon->log();
+  ASSERT_TRUE(wait_until([&] { return rig.answers(); }, slowed(30s))) << daemon->log();
   std::this_thread::sleep_for(1s);  // the CANopen nodes' first heartbeats
 
   // WHEN a calibration runs to its end
   ASSERT_TRUE(rig.ask("start")["ok"].boolean()) << daemon->log();
-  const calibctl::JsonValue status = rig.wait_for_end(240s);
+  const calibctl::JsonValue status = rig.wait_for_end(slowed(240s));
 
   // THEN it reaches its solve (whose validation refuses a fit the model
   // cannot explain, or finds too many rows off to be gross errors) and its
@@ -102,7 +103,7 @@ void expect_effect_named(const std::vector<std::string>& effect_options, const s
   ChildProcess diagnose({built_program("tools/cdpr-calib/cdpr-calib"), "diagnose", entry, "--output",
                          rig.dir + "/diagnosis"},
                         rig.dir + "/diagnose.log");
-  const std::optional<int> exit_status = diagnose.wait_exit(120s);
+  const std::optional<int> exit_status = diagnose.wait_exit(slowed(120s));
   const std::string output = diagnose.log();
   std::printf("diagnose: %s\n", output.substr(output.find("\nsummary: ") + 1).c_str());
   EXPECT_TRUE(exit_status.has_value()) << output;
@@ -131,11 +132,11 @@ TEST(HiddenEffectRun, TheOperatorCommitsTheNamedLoadCellBiasWithCalibctl) {
   // GIVEN the virtual large robot whose load cell reads 15 N too much, as the demo runs it
   VirtualRobotProcess rig("large", 20, "", {"--anchor-perturbation", "0.3", "--force-bias", "15"});
   auto daemon = rig.start_daemon("daemon");
-  ASSERT_TRUE(wait_until([&] { return rig.answers(); }, 30s)) << daemon->log();
+  ASSERT_TRUE(wait_until([&] { return rig.answers(); }, slowed(30s))) << daemon->log();
   std::this_thread::sleep_for(1s);  // the CANopen nodes' first heartbeats
   // AND a run whose fit the catenary cannot explain: refused, nothing committed
   ASSERT_TRUE(rig.ask("start")["ok"].boolean()) << daemon->log();
-  const calibctl::JsonValue status = rig.wait_for_end(240s);
+  const calibctl::JsonValue status = rig.wait_for_end(slowed(240s));
   ASSERT_EQ(status["reason"].string().rfind("fit refused: ", 0), 0u) << status["reason"].string();
   ASSERT_FALSE(rig.ask("show")["present"].boolean());
   const std::string entry = status["run"]["entry"].string();
@@ -146,7 +147,7 @@ TEST(HiddenEffectRun, TheOperatorCommitsTheNamedLoadCellBiasWithCalibctl) {
   EXPECT_EQ(run["named_terms"].array()[0].string(), "load_cell_bias");
   const std::string calibctl = built_program("tools/calibctl/calibctl");
   ChildProcess hint({calibctl, "--socket", rig.socket, "status"}, rig.dir + "/status.log");
-  EXPECT_EQ(hint.wait_exit(30s), std::optional<int>(0));
+  EXPECT_EQ(hint.wait_exit(slowed(30s)), std::optional<int>(0));
   EXPECT_NE(hint.log().find("calibctl commit --with-term load_cell_bias run-000001"), std::string::npos)
       << hint.log();
   // AND requests the daemon cannot serve are refused with their reason
@@ -156,7 +157,7 @@ TEST(HiddenEffectRun, TheOperatorCommitsTheNamedLoadCellBiasWithCalibctl) {
   // WHEN the operator commits with the named term
   ChildProcess commit({calibctl, "--socket", rig.socket, "commit", "--with-term", "load_cell_bias", "run-000001"},
                       rig.dir + "/commit.log");
-  const std::optional<int> exit_status = commit.wait_exit(240s);
+  const std::optional<int> exit_status = commit.wait_exit(slowed(240s));
   std::printf("calibctl commit --with-term: %s\n", commit.log().c_str());
 
   // THEN a calibration with the catenary plus the bias is committed
@@ -195,7 +196,7 @@ TEST(HiddenEffectRun, TheOperatorCommitsTheNamedLoadCellBiasWithCalibctl) {
         kept = rig.ask("show")["run"];
         return !kept["report"].is_null();
       },
-      120s));
+      slowed(120s)));
   EXPECT_NE(read_text(kept["entry"].string() + "/run.toml").find("refit_of = 1"), std::string::npos);
   EXPECT_NE(daemon->log().find("refit of run-000001 committed: committed calibration 1"), std::string::npos)
       << daemon->log();

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "slowdown.h"
 #include "virtual_robot_process.h"
 
 namespace cdpr::integration {
@@ -18,7 +19,7 @@ TEST(InterruptedRun, ADaemonKilledMidRunIsReportedAfterRestartUntilTheNextStart)
   // GIVEN the virtual small robot and a daemon calibrating it, at waypoint 2 or later
   VirtualRobotProcess rig;
   auto first = rig.start_daemon("first");
-  ASSERT_TRUE(wait_until([&] { return rig.answers(); }, 30s)) << first->log();
+  ASSERT_TRUE(wait_until([&] { return rig.answers(); }, slowed(30s))) << first->log();
   std::this_thread::sleep_for(1s);  // the CANopen nodes' first heartbeats
   ASSERT_TRUE(rig.ask("start")["ok"].boolean()) << first->log();
   calibctl::JsonValue status;
@@ -27,7 +28,7 @@ TEST(InterruptedRun, ADaemonKilledMidRunIsReportedAfterRestartUntilTheNextStart)
         status = rig.ask("status");
         return status["waypoint"].integer() >= 2 || !status["running"].boolean();
       },
-      120s))
+      slowed(120s)))
       << first->log();
   ASSERT_TRUE(status["running"].boolean()) << status["reason"].string() << "\n" << first->log();
   const int waypoint_seen = status["waypoint"].integer();
@@ -35,10 +36,10 @@ TEST(InterruptedRun, ADaemonKilledMidRunIsReportedAfterRestartUntilTheNextStart)
 
   // WHEN the daemon is killed with SIGKILL and started again
   first->signal(SIGKILL);
-  ASSERT_EQ(first->wait_exit(10s), std::optional<int>(128 + SIGKILL));
+  ASSERT_EQ(first->wait_exit(slowed(10s)), std::optional<int>(128 + SIGKILL));
   EXPECT_TRUE(std::filesystem::exists(rig.state_dir + "/run-in-progress.toml"));
   auto second = rig.start_daemon("second");
-  ASSERT_TRUE(wait_until([&] { return rig.answers(); }, 30s)) << second->log();
+  ASSERT_TRUE(wait_until([&] { return rig.answers(); }, slowed(30s))) << second->log();
 
   // THEN its status and log say the run was interrupted, at which waypoint of how many
   const std::string interrupted = rig.ask("status")["interrupted"].string();
@@ -54,16 +55,16 @@ TEST(InterruptedRun, ADaemonKilledMidRunIsReportedAfterRestartUntilTheNextStart)
   // AND calibctl status shows it to the operator
   ChildProcess calibctl({built_program("tools/calibctl/calibctl"), "--socket", rig.socket, "status"},
                         rig.dir + "/calibctl.log");
-  EXPECT_EQ(calibctl.wait_exit(30s), std::optional<int>(0));
+  EXPECT_EQ(calibctl.wait_exit(slowed(30s)), std::optional<int>(0));
   EXPECT_NE(calibctl.log().find("\n  interrupted: run interrupted at 20"), std::string::npos) << calibctl.log();
 
   // AND WHEN a new run starts THEN the report is gone; once it is aborted the marker is removed
   ASSERT_TRUE(rig.ask("start")["ok"].boolean()) << second->log();
   EXPECT_EQ(rig.ask("status")["interrupted"].string(), "");
   EXPECT_TRUE(rig.ask("abort")["ok"].boolean());
-  EXPECT_TRUE(wait_until([&] { return !std::filesystem::exists(rig.state_dir + "/run-in-progress.toml"); }, 10s));
+  EXPECT_TRUE(wait_until([&] { return !std::filesystem::exists(rig.state_dir + "/run-in-progress.toml"); }, slowed(10s)));
   second->signal(SIGTERM);
-  EXPECT_EQ(second->wait_exit(30s), std::optional<int>(0)) << second->log();
+  EXPECT_EQ(second->wait_exit(slowed(30s)), std::optional<int>(0)) << second->log();
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <thread>
 
+#include "slowdown.h"
 #include "virtual_robot_process.h"
 #include "../text_contains.h"
 
@@ -54,11 +55,11 @@ TEST(ReadOnlyStore, ReadOnlyFromTheStartTheRunIsRefusedBeforeAnythingMoves) {
   const std::string history = rig.state_dir + "/history";
   std::filesystem::create_directories(history);
   auto daemon = rig.start_daemon("daemon", in_own_mount_namespace(history, true));
-  ASSERT_TRUE(wait_until([&] { return rig.answers(); }, 30s)) << daemon->log();
+  ASSERT_TRUE(wait_until([&] { return rig.answers(); }, slowed(30s))) << daemon->log();
   std::this_thread::sleep_for(1s);
   // WHEN a calibration is started
   ASSERT_TRUE(rig.ask("start")["ok"].boolean());
-  const calibctl::JsonValue status = rig.wait_for_end(60s);
+  const calibctl::JsonValue status = rig.wait_for_end(slowed(60s));
   // THEN it fails in preflight, saying the store cannot be written and why
   EXPECT_EQ(status["state"].string(), "failed");
   const std::string reason = status["reason"].string();
@@ -78,13 +79,13 @@ TEST(ReadOnlyStore, TurningReadOnlyMidRunKeepsTheFitAndCommitRetriesIt) {
   const std::string history = rig.state_dir + "/history";
   std::filesystem::create_directories(history);
   auto daemon = rig.start_daemon("daemon", in_own_mount_namespace(history, false));
-  ASSERT_TRUE(wait_until([&] { return rig.answers(); }, 30s)) << daemon->log();
+  ASSERT_TRUE(wait_until([&] { return rig.answers(); }, slowed(30s))) << daemon->log();
   std::this_thread::sleep_for(1s);
   ASSERT_TRUE(rig.ask("start")["ok"].boolean());
-  ASSERT_TRUE(wait_until([&] { return rig.ask("status")["waypoint"].integer() >= 2; }, 60s)) << daemon->log();
+  ASSERT_TRUE(wait_until([&] { return rig.ask("status")["waypoint"].integer() >= 2; }, slowed(60s))) << daemon->log();
   // WHEN the history directory becomes read-only after preflight
   ASSERT_TRUE(remount(daemon->pid(), history, "ro"));
-  const calibctl::JsonValue status = rig.wait_for_end(240s);
+  const calibctl::JsonValue status = rig.wait_for_end(slowed(240s));
   // THEN the run fails at its commit, and the fit and its samples are kept in pending/
   const std::string reason = status["reason"].string();
   std::printf("reason: %s\n", reason.c_str());
@@ -99,12 +100,12 @@ TEST(ReadOnlyStore, TurningReadOnlyMidRunKeepsTheFitAndCommitRetriesIt) {
   // AND WHEN `calibctl commit` is run while it is still read-only THEN it fails and keeps them
   const std::string calibctl = built_program("tools/calibctl/calibctl");
   ChildProcess refused({calibctl, "--socket", rig.socket, "commit"}, rig.dir + "/commit-refused.log");
-  EXPECT_EQ(refused.wait_exit(30s), std::optional<int>(1)) << refused.log();
+  EXPECT_EQ(refused.wait_exit(slowed(30s)), std::optional<int>(1)) << refused.log();
   EXPECT_TRUE(contains(refused.log(), "failed again")) << refused.log();
   // AND WHEN the store is writable again THEN `calibctl commit` commits the kept fit
   ASSERT_TRUE(remount(daemon->pid(), history, "rw"));
   ChildProcess committed({calibctl, "--socket", rig.socket, "commit"}, rig.dir + "/commit.log");
-  EXPECT_EQ(committed.wait_exit(30s), std::optional<int>(0)) << committed.log();
+  EXPECT_EQ(committed.wait_exit(slowed(30s)), std::optional<int>(0)) << committed.log();
   std::printf("calibctl commit: %s", committed.log().c_str());
   EXPECT_TRUE(rig.ask("show")["present"].boolean());
   EXPECT_FALSE(std::filesystem::exists(rig.state_dir + "/pending"));

@@ -33,6 +33,7 @@
 
 #include "src/formats/calibration_toml.h"
 #include "../read_text.h"
+#include "slowdown.h"
 #include "virtual_robot_rig.h"
 
 namespace cdpr::integration {
@@ -195,17 +196,21 @@ class SandboxRig {
     std::ofstream(dir + "/group") << "root:x:0:\ncdpr-calib:x:" << kServiceId << ":\nrobot-operators:x:"
                                   << kOperatorsId << ":cdpr-calib\n";
     // The settings of make demo (tools/demo.sh) and of the in-process rig
-    // (fast_daemon_config): physics 20x real time, a loaded test machine.
+    // (fast_daemon_config): physics 20x real time, a loaded test machine
+    // (both stretched in the sanitizer build: slowdown.h).
     std::ofstream config(config_path());
     config << "robot = \"" << dir << "/robot/robot.toml\"\n"
            << "[store]\nstate_dir = \"" << dir << "/state\"\n"
            << "[control]\nsocket = \"" << socket << "\"\n";
     if (!control_group.empty()) config << "group = \"" << control_group << "\"\n";
-    config << "[winches]\nendpoint = \"" << robot->can_endpoint() << "\"\nheartbeat_timeout_ms = 3000\n"
-           << "[load_cell]\nendpoint = \"" << robot->modbus_endpoint() << "\"\n"
+    config << "[winches]\nendpoint = \"" << robot->can_endpoint()
+           << "\"\nheartbeat_timeout_ms = " << 3000 * slowdown() << "\n"
+           << "[winches.drive]\nconsumer_heartbeat_ms = " << 500 * slowdown() << "\n"
+           << "[load_cell]\nendpoint = \"" << robot->modbus_endpoint() << "\"\nfault_timeout_ms = "
+           << 1000 * slowdown() << "\n"
            << "[pose]\nendpoint = \"" << robot->pose_endpoint() << "\"\n"
            << "[button]\nkind = \"none\"\n"
-           << "[limits]\nsettle_timeout_s = 15.0\npose_stale_ms = 3000\n";
+           << "[limits]\nsettle_timeout_s = " << 15 * slowdown() << ".0\npose_stale_ms = " << 3000 * slowdown() << "\n";
   }
 
   ~SandboxRig() {
@@ -236,13 +241,13 @@ TEST(UnitSandbox, FullCalibrationOfTheVirtualRobotWithTheDaemonInsideTheUnitsSan
   // GIVEN the virtual large robot and cdpr-calibd in the unit's sandbox, the example's [control] (no group)
   SandboxRig rig;
   SandboxedDaemon daemon(rig.dir, rig.config_path(), rig.log_path());
-  ASSERT_TRUE(daemon.wait_for_socket(rig.socket, std::chrono::seconds(30)))
+  ASSERT_TRUE(daemon.wait_for_socket(rig.socket, slowed(std::chrono::seconds(30))))
       << "the sandboxed daemon did not open its control socket; its log:\n" << rig.log();
 
   // WHEN the operator starts a calibration (once the nodes' heartbeats are in) and it runs to its end
   std::this_thread::sleep_for(std::chrono::seconds(1));
   ASSERT_TRUE(ask_daemon(rig.socket, "start")["ok"].boolean()) << rig.log();
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(5);
+  const auto deadline = std::chrono::steady_clock::now() + slowed(std::chrono::minutes(5));
   calibctl::JsonValue status;
   do {
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
@@ -272,7 +277,7 @@ TEST(UnitSandbox, AControlGroupThatIsTheUnitsGroupNeedsNoChown) {
   // WHEN the daemon starts in the unit's sandbox
   SandboxedDaemon daemon(rig.dir, rig.config_path(), rig.log_path());
   // THEN its socket is there and answers (the socket took the group at bind, no chown was needed)
-  ASSERT_TRUE(daemon.wait_for_socket(rig.socket, std::chrono::seconds(30))) << rig.log();
+  ASSERT_TRUE(daemon.wait_for_socket(rig.socket, slowed(std::chrono::seconds(30)))) << rig.log();
   EXPECT_TRUE(ask_daemon(rig.socket, "status")["ok"].boolean());
   EXPECT_EQ(daemon.stop(), 0) << rig.log();
 }

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <thread>
 
+#include "slowdown.h"
 #include "virtual_robot_rig.h"
 
 namespace cdpr::integration {
@@ -40,7 +41,7 @@ TEST_P(VendorLoadCellRun, SamplesThePredictedTensions) {
   std::this_thread::sleep_for(std::chrono::seconds(1));
   ASSERT_TRUE(rig.ask("start")["ok"].boolean());
   calibctl::JsonValue status;
-  const auto give_up = Clock::now() + std::chrono::seconds(90);
+  const auto give_up = Clock::now() + slowed(std::chrono::seconds(90));
   do {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     status = rig.ask("status");
@@ -71,7 +72,7 @@ TEST_P(VendorLoadCellRun, AMissingDecimalPointStopsTheRunOnTheTensionLimit) {
   std::this_thread::sleep_for(std::chrono::seconds(1));
   ASSERT_TRUE(rig.ask("start")["ok"].boolean());
   calibctl::JsonValue status;
-  const auto give_up = Clock::now() + std::chrono::seconds(30);
+  const auto give_up = Clock::now() + slowed(std::chrono::seconds(30));
   do {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
     status = rig.ask("status");

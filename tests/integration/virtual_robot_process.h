@@ -2,9 +2,11 @@
 // The virtual robot as its own process and a cdpr-calibd configuration for
 // it, for the tests that run real daemon processes (kill -9, a read-only
 // store in a mount namespace, a hidden effect). The physics runs 20x faster
-// than real time; the daemon keeps its shipped equilibrium thresholds and,
-// for the small robot, gets its limits (the reference cable may dip below
-// the planner's 2 N while the small platform swings between waypoints).
+// than real time (slower in the sanitizer build, the daemon's timeouts
+// stretched alike: slowdown.h); the daemon keeps its shipped equilibrium
+// thresholds and, for the small robot, gets its limits (the reference cable
+// may dip below the planner's 2 N while the small platform swings between
+// waypoints).
 
 #include <chrono>
 #include <cstdlib>
@@ -17,6 +19,7 @@
 #include "calibctl/control_client.h"
 #include "calibctl/json_value.h"
 #include "daemon_process.h"
+#include "slowdown.h"
 
 namespace cdpr::integration {
 
@@ -35,21 +38,26 @@ class VirtualRobotProcess {
     socket = dir + "/control";
     state_dir = dir + "/state";
     std::vector<std::string> robot_argv{built_program("tools/virtual-robot/virtual-robot"), "--preset", preset,
-                                        "--seed", "1", "--time-scale", "20", "--endpoints", dir + "/robot"};
+                                        "--seed", "1", "--time-scale", std::to_string(robot_time_scale(20.0)),
+                                        "--endpoints", dir + "/robot"};
     robot_argv.insert(robot_argv.end(), robot_options.begin(), robot_options.end());
     robot_ = std::make_unique<ChildProcess>(robot_argv, dir + "/robot.log");
-    if (!wait_until([&] { return std::filesystem::exists(dir + "/robot/ready"); }, 60s)) {
+    if (!wait_until([&] { return std::filesystem::exists(dir + "/robot/ready"); }, slowed(60s))) {
       ADD_FAILURE() << "the virtual robot did not start: " << robot_->log();
     }
     config = dir + "/cdpr-calibd.toml";
     const bool small = preset == "small";
     std::ofstream(config) << "robot = \"" << dir << "/robot/robot.toml\"\n[store]\nstate_dir = \"" << state_dir
                           << "\"\n[control]\nsocket = \"" << socket << "\"\n[winches]\nendpoint = \"unix:" << dir
-                          << "/robot/can.sock\"\nheartbeat_timeout_ms = 3000\n[load_cell]\nendpoint = "
-                          << "\"tcp:127.0.0.1:" << ready_value("modbus_port") << "\"\n[pose]\nendpoint = \"unix:"
+                          << "/robot/can.sock\"\nheartbeat_timeout_ms = " << 3000 * slowdown()
+                          << "\n[winches.drive]\nconsumer_heartbeat_ms = " << 500 * slowdown()
+                          << "\n[load_cell]\nendpoint = "
+                          << "\"tcp:127.0.0.1:" << ready_value("modbus_port")
+                          << "\"\nfault_timeout_ms = " << 1000 * slowdown() << "\n[pose]\nendpoint = \"unix:"
                           << dir << "/robot/pose.sock\"\n[button]\nkind = \"none\"\n[limits]\n"
                           << (small ? "min_tension = 0.5\nmax_tension = 300.0\n" : "")
-                          << "pose_stale_ms = 3000\nsettle_timeout_s = 15.0\n[waypoints]\n"
+                          << "pose_stale_ms = " << 3000 * slowdown() << "\nsettle_timeout_s = " << 15 * slowdown()
+                          << ".0\n[waypoints]\n"
                           << (small ? "min_tension = 2.0\nmax_tension = 300.0\nmargin = 1.5\nz_min = 3.0\n"
                                       "z_max = 18.0\n"
                                     : "")
@@ -57,7 +65,7 @@ class VirtualRobotProcess {
   }
   ~VirtualRobotProcess() {
     robot_->signal(SIGTERM);
-    robot_->wait_exit(std::chrono::seconds(30));
+    robot_->wait_exit(slowed(std::chrono::seconds(30)));
     if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
   }
 
@@ -71,7 +79,7 @@ class VirtualRobotProcess {
   calibctl::JsonValue ask(const std::string& request) const {
     calibctl::ControlClient client;
     std::string error, response;
-    if (!client.connect(socket, error) || !client.request(request, response, error, 30'000)) return {};
+    if (!client.connect(socket, error) || !client.request(request, response, error, 30'000 * slowdown())) return {};
     auto value = calibctl::JsonValue::parse(response);
     return value ? *value : calibctl::JsonValue{};
   }

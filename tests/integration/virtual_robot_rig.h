@@ -27,6 +27,7 @@
 #include "src/calibration/waypoint_planner.h"
 #include "src/daemon/daemon_loop.h"
 #include "src/daemon/load_cell_presets.h"
+#include "slowdown.h"
 #include "virtual-robot/virtual_robot.h"
 
 namespace cdpr::integration {
@@ -41,7 +42,8 @@ class NullNotifier final : public daemon::ServiceNotifier {
 
 // The daemon settings of the demo: the endpoints of the virtual robot, whose
 // physics runs time_scale times faster, and timeouts that allow for a
-// loaded test machine; the equilibrium thresholds are the shipped ones.
+// loaded test machine (and for the sanitizer build: slowdown.h); the
+// equilibrium thresholds are the shipped ones.
 inline daemon::DaemonConfig fast_daemon_config(const std::string& dir, const virtual_robot::VirtualRobot& robot) {
   daemon::DaemonConfig config = daemon::default_daemon_config();
   config.store.state_dir = dir + "/state";
@@ -57,16 +59,17 @@ inline daemon::DaemonConfig fast_daemon_config(const std::string& dir, const vir
   config.load_cell.slave_id = robot.options().load_cell.unit_id;
   config.pose.endpoint = robot.pose_endpoint();
   config.button.gpio = false;
-  config.calibrator.settle_timeout_us = 15'000'000;
+  config.calibrator.settle_timeout_us = slowed_us(15'000'000);
   // The virtual robot answers CAN, Modbus and the pose stream from the thread
   // that also solves its physics, on a machine shared with the other tests:
   // a stall of a few hundred ms is the test machine, not a fault under test
   // (the fault tests with injected clocks cover silent nodes and stale poses).
-  config.winches.heartbeat_timeout_us = 3'000'000;
+  config.winches.heartbeat_timeout_us = slowed_us(3'000'000);
   // Simulated time runs faster: a 2 m/s cable pays out 2 x time_scale m per real second.
   config.winches.max_speed_mps = 5.0 * robot.time_scale();
-  config.winches.drive.consumer_heartbeat_us = 3'000'000;
-  config.calibrator.monitor.pose_stale_us = 3'000'000;
+  config.winches.drive.consumer_heartbeat_us = slowed_us(3'000'000);
+  config.calibrator.monitor.pose_stale_us = slowed_us(3'000'000);
+  config.load_cell.fault_timeout_us = slowed_us(config.load_cell.fault_timeout_us);
   return config;
 }
 
@@ -85,13 +88,14 @@ inline void use_small_robot_limits(daemon::DaemonConfig& config) {
 }
 
 // The field calibration's acceptance scenario: the large robot, seed 1, nominal anchors
-// 0.3 m off the truth, physics 20x faster than real time. The test that runs
+// 0.3 m off the truth, physics 20x faster than real time (slower in the
+// sanitizer build: slowdown.h). The test that runs
 // it and the one that checks its plan share it, so both see the same robot.
 inline virtual_robot::VirtualRobotOptions large_robot_acceptance_options() {
   virtual_robot::VirtualRobotOptions options;
   options.preset = sim::Preset::kLarge;
   options.seed = 1;
-  options.time_scale = 20.0;
+  options.time_scale = robot_time_scale(20.0);
   options.anchor_perturbation_m = 0.3;
   return options;
 }
