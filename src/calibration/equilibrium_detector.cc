@@ -236,16 +236,19 @@ EquilibriumDetector::ReturnTest EquilibriumDetector::return_beyond_noise(std::si
   const Eigen::Vector3d rest = rest_sum / static_cast<double>(rest_count);
   // Noise variance of one observation, summed over the axes.
   const double noise_var = step_square.sum() / (2.0 * static_cast<double>(count_ - begin - 1));
-  // Each bin's distance from the rest window's mean; a later bin farther
-  // than an earlier one, beyond the noise of the two bin means, is a return.
+  // Each bin's distance from the rest window's mean, once per bin (in the
+  // slot the sway fit keeps its time in); a later bin farther than an
+  // earlier one, beyond the noise of the two bin means, is a return.
   for (int k = 0; k < bin_count; ++k) {
     if (bins_[k][4] == 0.0) continue;
-    const double dk = (Eigen::Vector3d(bins_[k][1], bins_[k][2], bins_[k][3]) / bins_[k][4] - rest).norm();
+    bins_[k][0] = (Eigen::Vector3d(bins_[k][1], bins_[k][2], bins_[k][3]) / bins_[k][4] - rest).norm();
+  }
+  for (int k = 0; k < bin_count; ++k) {
+    if (bins_[k][4] == 0.0) continue;
     for (int j = 0; j < k; ++j) {
       if (bins_[j][4] == 0.0) continue;
-      const double dj = (Eigen::Vector3d(bins_[j][1], bins_[j][2], bins_[j][3]) / bins_[j][4] - rest).norm();
       const double noise = kNoiseAllowance * std::sqrt(noise_var * (1.0 / bins_[j][4] + 1.0 / bins_[k][4]));
-      out.excess_m = std::max(out.excess_m, dk - dj - noise);
+      out.excess_m = std::max(out.excess_m, bins_[k][0] - bins_[j][0] - noise);
     }
   }
   return out;

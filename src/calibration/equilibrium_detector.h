@@ -262,7 +262,8 @@ class EquilibriumDetector {
   std::size_t added_ = 0;       // observations added since reset()
   mutable SwayFit sway_;
   mutable bool last_check_sway_ = false;  // average() is then the fit's
-  // Bin means of the sway window's position (time [s], x, y, z, count).
+  // Bin means of the sway window's position (time [s], x, y, z, count);
+  // the return test keeps each bin's distance from rest in the time slot.
   mutable std::vector<std::array<double, 5>> bins_;
   // One coordinate's values and the fit's basis functions over the sway window.
   mutable std::vector<double> values_;
