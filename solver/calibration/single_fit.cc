@@ -190,6 +190,8 @@ std::vector<SensorReading> robust_stages(BuiltProblem& built, LevenbergMarquardt
     const SolverSummary s = lm.solve();
     if (iterations == 0) summary.initial_cost = s.initial_cost;
     iterations += s.iterations;
+    summary.iterations = iterations;
+    summary.successful_steps += s.successful_steps;
     summary.termination = s.termination;
     summary.message = s.message;
     summary.final_cost = s.final_cost;
@@ -285,6 +287,7 @@ CalibrationResult calibrate_once(const Robot& robot, const std::vector<Sample>& 
   result.solver = lm.solve();
   if (iterations > 0) result.solver.initial_cost = robust_summary.initial_cost;
   result.solver.iterations += iterations;
+  result.solver.successful_steps += robust_summary.successful_steps;
   result.message = result.solver.message;
   if (!result.solver.usable()) return result;
   std::vector<Key> globals;

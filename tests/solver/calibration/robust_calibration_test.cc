@@ -75,6 +75,26 @@ TEST(RobustCalibration, PlantedGrossErrorsAreRejectedAndNamed) {
   EXPECT_FALSE(result.misfit) << result.calibration.model_warning;
 }
 
+TEST(RobustCalibration, TheSummaryCountsTheStepsOfEveryStage) {
+  // GIVEN clean data, fitted in the robust stage and then the final one
+  const sim::SimulatedDataset data = simulate(large(35, 5));
+  CalibrationOptions options;
+  int iterations = 0;
+  int accepted = 0;
+  options.progress = [&](const IterationSummary& s) {
+    iterations += s.iteration > 0;
+    accepted += s.iteration > 0 && s.step_accepted;
+  };
+  // WHEN calibrated
+  const CalibrationResult result = calibrate(data.nominal, data.samples, options);
+  // THEN the summary's iterations and accepted steps are those of every
+  // stage together, as the progress lines showed them
+  ASSERT_TRUE(result.ok) << result.message;
+  EXPECT_GT(accepted, 0);
+  EXPECT_EQ(result.solver.iterations, iterations);
+  EXPECT_EQ(result.solver.successful_steps, accepted);
+}
+
 TEST(RobustCalibration, CleanDataGivesTheLeastSquaresFitAndItsSigmas) {
   // GIVEN effect-free data without gross errors
   const sim::SimulatedDataset data = simulate(large(35, 5));
