@@ -9,6 +9,9 @@
 
 #include "solver/calibration/effect_pose_factor.h"
 #include "solver/calibration/pose_prior_factor.h"
+#include "solver/linalg/block_copy.h"
+#include "solver/linalg/dense_kernels.h"
+#include "solver/linalg/group_kernels.h"
 #include "solver/nls/factor_parameters.h"
 #include "solver/nls/trust_region_strategy.h"
 
@@ -349,12 +352,22 @@ double largest_studentised_residual(const Sample& sample, std::span<const double
       force_jacobian.size() != kRowFactorRows * 2 || prior_jacobian.size() != kRowPriorRows * 6) {
     return kUnknown;
   }
-  // h = |L^-1 j_r|^2 with J^T J = L L^T: cheaper than studentise()'s
-  // pivoted LDLT, and the margins cover the difference.
-  const RowJacobian j = row_jacobian(pose_jacobian.data(), force_jacobian.data(), prior_jacobian.data());
-  if (!j.allFinite()) return kUnknown;
-  const Eigen::LLT<Eigen::Matrix<double, kRowUnknowns, kRowUnknowns>> information(j.transpose() * j);
-  if (information.info() != Eigen::Success) return kUnknown;
+  // h = |U'^-1 j_r|^2 with J^T J = U'U, by the solver's dense kernels: far
+  // cheaper than studentise()'s pivoted LDLT, and the margins cover the
+  // difference. The factor's rows as one 9 x 8 matrix (pose, then force).
+  std::array<double, kRowFactorRows * kRowUnknowns> local;
+  copy_block_columns(kRowFactorRows, 6, pose_jacobian.data(), local.data(), kRowUnknowns);
+  copy_block_columns(kRowFactorRows, 2, force_jacobian.data(), local.data() + 6, kRowUnknowns);
+  if (!all_finite(local.data(), local.size()) || !all_finite(prior_jacobian.data(), prior_jacobian.size())) {
+    return kUnknown;
+  }
+  std::array<double, kRowUnknowns * kRowUnknowns> u{};
+  std::array<double, kRowUnknowns> inverse;
+  add_transposed_product(kRowFactorRows, kRowUnknowns, kRowUnknowns, local.data(), kRowUnknowns, local.data(),
+                         kRowUnknowns, u.data(), kRowUnknowns, 1.0, true);
+  add_transposed_product(kRowPriorRows, 6, 6, prior_jacobian.data(), 6, prior_jacobian.data(), 6, u.data(),
+                         kRowUnknowns, 1.0, true);
+  if (!group_kernels::cholesky_upper<kRowUnknowns>(u.data(), kRowUnknowns, inverse.data())) return kUnknown;
   const LeftOutRows left_out = left_out_rows(sample);
   double largest = 0.0;
   for (int r : kReadingRows) {
@@ -362,8 +375,12 @@ double largest_studentised_residual(const Sample& sample, std::span<const double
         left_out.rows.begin() + left_out.count) {
       continue;
     }
-    const Eigen::Matrix<double, kRowUnknowns, 1> w = information.matrixL().solve(j.row(r).transpose());
-    const double free = 1.0 - w.squaredNorm();
+    std::array<double, kRowUnknowns> w;
+    std::copy_n(local.data() + r * kRowUnknowns, kRowUnknowns, w.data());
+    group_kernels::solve_upper_transposed<kRowUnknowns>(u.data(), inverse.data(), kRowUnknowns, w.data());
+    double h = 0.0;
+    for (double x : w) h += x * x;
+    const double free = 1.0 - h;
     if (!(free >= kScreenFree) || !std::isfinite(residual[r])) return kUnknown;
     largest = std::max(largest, std::abs(residual[r]) / std::sqrt(free));
   }
