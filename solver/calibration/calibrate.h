@@ -5,6 +5,7 @@
 // Pure numerics: no I/O, no clock; progress is reported through a callback.
 
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -92,6 +93,10 @@ struct FittedRow {
   Sample sample;
   Pose world_T_platform;
   Eigen::Vector2d reference_force = Eigen::Vector2d::Zero();
+  // The largest studentised residual of its kept readings from the
+  // solver's own last linearisation (largest_studentised_residual,
+  // solver/calibration/row_attribution.h); infinity when not known.
+  double largest_studentised = std::numeric_limits<double>::infinity();
 };
 
 // Why a fit is flagged (CalibrationResult::misfit), the first that applies.

@@ -9,6 +9,9 @@
 
 #include "solver/calibration/effect_pose_factor.h"
 #include "solver/calibration/pose_prior_factor.h"
+#include "solver/linalg/block_copy.h"
+#include "solver/linalg/dense_kernels.h"
+#include "solver/linalg/group_kernels.h"
 #include "solver/nls/factor_parameters.h"
 #include "solver/nls/trust_region_strategy.h"
 
@@ -279,11 +282,113 @@ std::vector<SensorReading> attribute_row(const Problem& problem, int row_id, int
   return out;
 }
 
+namespace {
+
+constexpr int kRowFactorRows = EffectPoseFactor::kResidualDim;
+constexpr int kRowPriorRows = 6;
+constexpr int kRowUnknowns = 8;  // pose tangent (6), reference force (2)
+using RowJacobian = Eigen::Matrix<double, kRowFactorRows + kRowPriorRows, kRowUnknowns>;
+using RowResidual = std::array<double, kRowFactorRows>;
+
+// A kept reading of a row and 1 - h, h its leverage in the row's fit.
+struct Studentised {
+  SensorReading reading;  // value: the whitened residual
+  double free = 0.0;
+};
+
+// Every reading the row kept, with 1 - h from `j` (the reading factor's
+// rows, then the pose prior's; pose then reference-force columns). False
+// when `j` is not finite or the row's information not positive definite.
+bool studentise(const Robot& robot, const Sample& sample, const RowJacobian& j, const RowResidual& residual,
+                std::vector<Studentised>& out) {
+  out.clear();
+  if (!j.allFinite()) return false;
+  const Eigen::LDLT<Eigen::Matrix<double, kRowUnknowns, kRowUnknowns>> information(j.transpose() * j);
+  if (information.info() != Eigen::Success || !information.isPositive()) return false;
+  const LeftOutRows left_out = left_out_rows(sample);
+  for (int reading = 0; reading <= kCableCount; ++reading) {
+    const int r = kReadingRows[reading];
+    if (std::find(left_out.rows.begin(), left_out.rows.begin() + left_out.count, r) !=
+        left_out.rows.begin() + left_out.count) {
+      continue;
+    }
+    const Eigen::Matrix<double, kRowUnknowns, 1> jr = j.row(r).transpose();
+    const bool force_row = reading == kCableCount;
+    out.push_back({{sample.id, force_row ? SensorKind::kForce : SensorKind::kEncoder,
+                    force_row ? robot.reference_cable : reading, residual[r]},
+                   1.0 - jr.dot(information.solve(jr))});
+  }
+  return true;
+}
+
+// The row's Jacobian from its reading factor's pose and force blocks
+// (kRowFactorRows x 6, x 2) and its pose prior's pose block (kRowPriorRows x 6),
+// each row-major.
+RowJacobian row_jacobian(const double* pose_jacobian, const double* force_jacobian, const double* prior_jacobian) {
+  RowJacobian j = RowJacobian::Zero();
+  for (int r = 0; r < kRowFactorRows; ++r) {
+    for (int c = 0; c < 6; ++c) j(r, c) = pose_jacobian[r * 6 + c];
+    for (int c = 0; c < 2; ++c) j(r, 6 + c) = force_jacobian[r * 2 + c];
+  }
+  for (int r = 0; r < kRowPriorRows; ++r) {
+    for (int c = 0; c < 6; ++c) j(kRowFactorRows + r, c) = prior_jacobian[r * 6 + c];
+  }
+  return j;
+}
+
+// A row's screening value below the bar by less than this fraction, or a
+// reading's 1 - h below kScreenFree, is not trusted to rule the row out:
+// the two evaluations agree to rounding, far inside both.
+constexpr double kScreenMargin = 1e-3;
+constexpr double kScreenFree = 1e-3;
+
+}  // namespace
+
+double largest_studentised_residual(const Sample& sample, std::span<const double> residual,
+                                    std::span<const double> pose_jacobian, std::span<const double> force_jacobian,
+                                    std::span<const double> prior_jacobian) {
+  constexpr double kUnknown = std::numeric_limits<double>::infinity();
+  if (residual.size() != kRowFactorRows || pose_jacobian.size() != kRowFactorRows * 6 ||
+      force_jacobian.size() != kRowFactorRows * 2 || prior_jacobian.size() != kRowPriorRows * 6) {
+    return kUnknown;
+  }
+  // h = |U'^-1 j_r|^2 with J^T J = U'U, by the solver's dense kernels: far
+  // cheaper than studentise()'s pivoted LDLT, and the margins cover the
+  // difference. The factor's rows as one 9 x 8 matrix (pose, then force).
+  std::array<double, kRowFactorRows * kRowUnknowns> local;
+  copy_block_columns(kRowFactorRows, 6, pose_jacobian.data(), local.data(), kRowUnknowns);
+  copy_block_columns(kRowFactorRows, 2, force_jacobian.data(), local.data() + 6, kRowUnknowns);
+  if (!all_finite(local.data(), local.size()) || !all_finite(prior_jacobian.data(), prior_jacobian.size())) {
+    return kUnknown;
+  }
+  std::array<double, kRowUnknowns * kRowUnknowns> u{};
+  std::array<double, kRowUnknowns> inverse;
+  add_transposed_product(kRowFactorRows, kRowUnknowns, kRowUnknowns, local.data(), kRowUnknowns, local.data(),
+                         kRowUnknowns, u.data(), kRowUnknowns, 1.0, true);
+  add_transposed_product(kRowPriorRows, 6, 6, prior_jacobian.data(), 6, prior_jacobian.data(), 6, u.data(),
+                         kRowUnknowns, 1.0, true);
+  if (!group_kernels::cholesky_upper<kRowUnknowns>(u.data(), kRowUnknowns, inverse.data())) return kUnknown;
+  const LeftOutRows left_out = left_out_rows(sample);
+  double largest = 0.0;
+  for (int r : kReadingRows) {
+    if (std::find(left_out.rows.begin(), left_out.rows.begin() + left_out.count, r) !=
+        left_out.rows.begin() + left_out.count) {
+      continue;
+    }
+    std::array<double, kRowUnknowns> w;
+    std::copy_n(local.data() + r * kRowUnknowns, kRowUnknowns, w.data());
+    group_kernels::solve_upper_transposed<kRowUnknowns>(u.data(), inverse.data(), kRowUnknowns, w.data());
+    double h = 0.0;
+    for (double x : w) h += x * x;
+    const double free = 1.0 - h;
+    if (!(free >= kScreenFree) || !std::isfinite(residual[r])) return kUnknown;
+    largest = std::max(largest, std::abs(residual[r]) / std::sqrt(free));
+  }
+  return largest;
+}
+
 std::vector<SensorReading> hidden_gross_errors(const Robot& robot, const CalibrationOptions& options,
                                                const CalibrationResult& result, double bar_sigma) {
-  constexpr int kFactorRows = EffectPoseFactor::kResidualDim;
-  constexpr int kPriorRows = 6;
-  constexpr int kLocal = 8;  // pose tangent (6), reference force (2)
   std::vector<SensorReading> out;
   if (!result.ok || options.cable_model != CableModelKind::kCatenary ||
       result.calibration.winches.size() != static_cast<std::size_t>(kCableCount) ||
@@ -306,18 +411,22 @@ std::vector<SensorReading> hidden_gross_errors(const Robot& robot, const Calibra
   for (const FittedEffect& e : result.effects) effect_values.push_back(e.value);
   for (const std::vector<double>& v : effect_values) parameters.push_back(v.data());
 
-  std::array<double, kFactorRows * 6> pose_jacobian{};
-  std::array<double, kFactorRows * 2> force_jacobian{};
+  std::array<double, kRowFactorRows * 6> pose_jacobian{};
+  std::array<double, kRowFactorRows * 2> force_jacobian{};
   std::vector<double*> jacobians(parameters.size(), nullptr);
   jacobians[0] = pose_jacobian.data();
   jacobians[1] = force_jacobian.data();
-  std::array<double, kPriorRows * 6> prior_jacobian{};
+  std::array<double, kRowPriorRows * 6> prior_jacobian{};
   double* prior_jacobians[] = {prior_jacobian.data()};
-  std::array<double, kFactorRows> residual{};
-  std::array<double, kPriorRows> prior_residual{};
+  RowResidual residual{};
+  std::array<double, kRowPriorRows> prior_residual{};
+  std::vector<Studentised> readings;
   const Loss loss{options.huber_width};
   for (std::size_t k = 0; k < result.fitted_rows.size(); ++k) {
     const FittedRow& row = result.fitted_rows[k];
+    // A row the fit's own linearisation puts clearly below the bar has
+    // no reading to name.
+    if (row.largest_studentised * (1.0 + kScreenMargin) < bar_sigma) continue;
     const Eigen::Vector3d& p = row.world_T_platform.position_world;
     const Eigen::Quaterniond& q = row.world_T_platform.world_R_platform;
     pose = {p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z()};
@@ -332,31 +441,17 @@ std::vector<SensorReading> hidden_gross_errors(const Robot& robot, const Calibra
         !factor.evaluate(parameters.data(), residual.data(), jacobians.data(), &cost)) {
       continue;
     }
-    Eigen::Matrix<double, kFactorRows + kPriorRows, kLocal> j = Eigen::Matrix<double, kFactorRows + kPriorRows, kLocal>::Zero();
-    for (int r = 0; r < kFactorRows; ++r) {
-      for (int c = 0; c < 6; ++c) j(r, c) = pose_jacobian[r * 6 + c];
-      for (int c = 0; c < 2; ++c) j(r, 6 + c) = force_jacobian[r * 2 + c];
+    if (!studentise(robot, row.sample,
+                    row_jacobian(pose_jacobian.data(), force_jacobian.data(), prior_jacobian.data()), residual,
+                    readings)) {
+      continue;
     }
-    for (int r = 0; r < kPriorRows; ++r) {
-      for (int c = 0; c < 6; ++c) j(kFactorRows + r, c) = prior_jacobian[r * 6 + c];
-    }
-    if (!j.allFinite()) continue;
-    const Eigen::LDLT<Eigen::Matrix<double, kLocal, kLocal>> information(j.transpose() * j);
-    if (information.info() != Eigen::Success || !information.isPositive()) continue;
-    const LeftOutRows left_out = left_out_rows(row.sample);
     std::vector<SensorReading> studentised;
-    for (int reading = 0; reading <= kCableCount; ++reading) {
-      const int r = kReadingRows[reading];
-      if (std::find(left_out.rows.begin(), left_out.rows.begin() + left_out.count, r) !=
-          left_out.rows.begin() + left_out.count) {
-        continue;
-      }
-      const Eigen::Matrix<double, kLocal, 1> jr = j.row(r).transpose();
-      const double free = 1.0 - jr.dot(information.solve(jr));
-      if (!(free > 1e-9) || !std::isfinite(residual[r])) continue;
-      const bool force_row = reading == kCableCount;
-      studentised.push_back({row.sample.id, force_row ? SensorKind::kForce : SensorKind::kEncoder,
-                             force_row ? robot.reference_cable : reading, residual[r] / std::sqrt(free)});
+    for (const Studentised& s : readings) {
+      if (!(s.free > 1e-9) || !std::isfinite(s.reading.value)) continue;
+      SensorReading t = s.reading;
+      t.value /= std::sqrt(s.free);
+      studentised.push_back(t);
     }
     for (const SensorReading& s : studentised) {
       const bool told_apart = std::all_of(studentised.begin(), studentised.end(), [&](const SensorReading& o) {

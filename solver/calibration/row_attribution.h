@@ -19,6 +19,7 @@
 // carries its residual in the refit without all of them: its prediction
 // minus the reading.
 
+#include <span>
 #include <vector>
 
 #include "solver/calibration/calibrate.h"
@@ -59,8 +60,20 @@ std::vector<SensorReading> attribute_row(const Problem& problem, int row_id, int
 // other reading's of its row by more than 10.83 (the data tell it from
 // them, as in attribute_row), worst first. Readings the row's unknowns
 // carry entirely (h within 1e-9 of 1) are not tested. Empty when the fit
-// failed or is rigid.
+// failed or is rigid. Rows whose FittedRow::largest_studentised is below
+// bar_sigma by a margin are not evaluated again.
 std::vector<SensorReading> hidden_gross_errors(const Robot& robot, const CalibrationOptions& options,
                                                const CalibrationResult& result, double bar_sigma);
+
+// The largest studentised residual among `sample`'s kept readings, as
+// hidden_gross_errors computes it, from the whitened residuals and Jacobian
+// blocks a solver evaluated at the fit (after the loss hidden_gross_errors
+// uses): the row's reading factor's residuals and its pose and reference
+// force blocks, the pose prior's pose block, each row-major. Infinity when
+// it cannot be told safely (blocks of other sizes, a singular row, a
+// reading the row's unknowns carry almost entirely).
+double largest_studentised_residual(const Sample& sample, std::span<const double> residual,
+                                    std::span<const double> pose_jacobian, std::span<const double> force_jacobian,
+                                    std::span<const double> prior_jacobian);
 
 }  // namespace cdpr

@@ -337,7 +337,12 @@ CalibrationResult calibrate_once(const Robot& robot, const std::vector<Sample>& 
     result.fitted_rows.reserve(samples.size());
     for (std::size_t k = 0; k < samples.size(); ++k) {
       const int pose = static_cast<int>(k);
-      result.fitted_rows.push_back({samples[k], problem.pose(PoseKey(pose)), problem.vector(ReferenceForceKey(pose))});
+      const int factor = built.reading_factor[k];  // its pose prior precedes it; keys: pose, reference force
+      result.fitted_rows.push_back({samples[k], problem.pose(PoseKey(pose)), problem.vector(ReferenceForceKey(pose)),
+                                    largest_studentised_residual(samples[k], lm.last_residuals(factor),
+                                                                 lm.last_jacobian(factor, 0),
+                                                                 lm.last_jacobian(factor, 1),
+                                                                 lm.last_jacobian(factor - 1, 0))});
     }
   }
   result.chi_square = 2.0 * result.solver.final_cost;

@@ -397,6 +397,13 @@ std::span<const double> LevenbergMarquardt::last_residuals(int factor) const {
   return impl_->system->linearization().jacobian().residual_values(impl_->slot, factor);
 }
 
+std::span<const double> LevenbergMarquardt::last_jacobian(int factor, int key) const {
+  const BlockJacobian& j = impl_->system->linearization().jacobian();
+  const double* block = impl_->linearized ? j.jacobian(impl_->slot, factor, key) : nullptr;
+  if (block == nullptr) return {};
+  return {block, static_cast<std::size_t>(j.residual_dim(factor)) * j.key_dim(factor, key)};
+}
+
 LinearSystemKind LevenbergMarquardt::linear_system() const { return impl_->system->kind(); }
 
 Eigen::MatrixXd LevenbergMarquardt::covariance(const std::vector<Key>& keys) {

@@ -106,6 +106,10 @@ class LevenbergMarquardt {
   // Factor `factor`'s residuals (whitened, after its loss) where the last
   // solve() ended; empty when it could not evaluate its start.
   std::span<const double> last_residuals(int factor) const;
+  // The Jacobian block of keys()[key] of factor `factor` there (whitened,
+  // after its loss; residual_dim x tangent dim, row-major); empty when the
+  // variable is held constant or the start could not be evaluated.
+  std::span<const double> last_jacobian(int factor, int key) const;
 
   // Which linear system the constructor chose for this problem.
   LinearSystemKind linear_system() const;
