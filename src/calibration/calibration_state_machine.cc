@@ -65,6 +65,8 @@ bool CalibrationStateMachine::request_start(hal::TimeUs now_us) {
   status_.started_us = now_us;
   status_.note = "started";
   enable_sent_us_.reset();
+  drives_enabled_ = false;
+  planned_ = false;
   previous_.reset();
   waypoints_ = WaypointSequence{};
   job_.reset();
@@ -139,7 +141,9 @@ void CalibrationStateMachine::fail(const std::string& reason, hal::TimeUs now_us
                                                   : std::string()) +
                             ")";
   enter(CalibrationState::kAbort, now_us);
-  // A waypoint job still away is dropped when it comes back.
+  // A waypoint job still away is dropped when it comes back: the run does
+  // not go on with it. Its waypoints stay the run's record (plan()).
+  if (job_) waypoints_ = std::move(job_->sequence);
   job_.reset();
   after_job_ = AfterJob::kNone;
   job_waypoint_.reset();
@@ -188,8 +192,7 @@ void CalibrationStateMachine::step(hal::TimeUs now_us) {
         return;
       }
     }
-    const bool drives_enabled = state != CalibrationState::kPreflight;
-    if (std::string fault = monitor_.check(now_us, drives_enabled); !fault.empty()) return fail(fault, now_us, true);
+    if (std::string fault = monitor_.check(now_us, drives_enabled_); !fault.empty()) return fail(fault, now_us, true);
   }
   if (after_job_ != AfterJob::kNone) return;  // the waypoint job is away: status as it left
   switch (state) {
@@ -210,19 +213,23 @@ void CalibrationStateMachine::step(hal::TimeUs now_us) {
 }
 
 void CalibrationStateMachine::run_preflight(hal::TimeUs now_us) {
+  // Before anything moves: a run whose fit could not be committed would be wasted.
+  if (const auto probed = devices_.store.probe_writable(); !probed) {
+    return fail("the store cannot be written (" + probed.error().message() + "): a fit could not be committed",
+                now_us, false);
+  }
+  auto current = devices_.store.load_current();
+  if (current) {
+    previous_ = std::move(*current);
+  } else {
+    status_.note = "current calibration unreadable (" + current.error().message() +
+                   "): calibrating without the change check";
+  }
+  enter(CalibrationState::kPlan, now_us);
+}
+
+void CalibrationStateMachine::enable_drives(hal::TimeUs now_us) {
   if (!enable_sent_us_) {
-    // Before anything moves: a run whose fit could not be committed would be wasted.
-    if (const auto probed = devices_.store.probe_writable(); !probed) {
-      return fail("the store cannot be written (" + probed.error().message() + "): a fit could not be committed",
-                  now_us, false);
-    }
-    auto current = devices_.store.load_current();
-    if (current) {
-      previous_ = std::move(*current);
-    } else {
-      status_.note = "current calibration unreadable (" + current.error().message() +
-                     "): calibrating without the change check";
-    }
     if (const hal::Status s = devices_.winches.enable(); !s.ok()) return fail("enable: " + s.to_string(), now_us, true);
     enable_sent_us_ = now_us;
     status_.detail = "enabling drives";
@@ -239,10 +246,15 @@ void CalibrationStateMachine::run_preflight(hal::TimeUs now_us) {
       return;
     }
   }
-  enter(CalibrationState::kPlan, now_us);
+  drives_enabled_ = true;
+  targets_sent_ = false;
+  enter(CalibrationState::kMove, now_us);
+  status_.waypoint = 1;
 }
 
 void CalibrationStateMachine::run_plan(hal::TimeUs now_us) {
+  // The drives are enabled once the plan exists (the header says why).
+  if (planned_) return enable_drives(now_us);
   const Readings& readings = monitor_.readings();
   const Eigen::Vector3d start_world(readings.pose->platform_world.x, readings.pose->platform_world.y,
                                     readings.pose->platform_world.z);
@@ -279,9 +291,8 @@ void CalibrationStateMachine::after_plan(const std::string& problem, hal::TimeUs
   run_log_.waypoints_planned = status_.waypoint_count;
   update_waypoint_status();
   log_run(now_us);
-  targets_sent_ = false;
-  enter(CalibrationState::kMove, now_us);
-  status_.waypoint = 1;
+  planned_ = true;
+  enable_drives(now_us);
 }
 
 void CalibrationStateMachine::run_move(hal::TimeUs now_us) {
@@ -394,7 +405,11 @@ WaypointJob CalibrationStateMachine::take_waypoint_job() {
 
 void CalibrationStateMachine::deliver_waypoint_job(WaypointJob job, hal::TimeUs now_us) {
   job_out_ = false;
-  if (after_job_ == AfterJob::kNone) return;  // the run ended meanwhile: dropped
+  if (after_job_ == AfterJob::kNone) {
+    // The run ended meanwhile: it does not go on; plan() shows its waypoints again.
+    waypoints_ = std::move(job.sequence);
+    return;
+  }
   finish_job(std::move(job), now_us);
 }
 

@@ -9,15 +9,21 @@
 //
 // preflight  the store proves it can write (a run it could not commit is
 //            not started); every winch alive, pose fresh and valid, load cell
-//            answering and the tension inside its limits; enable the drives and wait for
-//            operation enabled (enable_timeout_us). Encoder offsets for the
-//            payout targets: the current calibration's, else estimated at the
-//            start pose (waypoint_planner.h).
+//            answering and the tension inside its limits. The drives stay
+//            disabled.
 // plan       the waypoints (waypoint_sequence.h) with the current
 //            calibration's anchors when one exists, else the nominal ones: a
 //            fixed plan (spread, informative) or the sequential strategy's
 //            candidates; an infeasible plan fails the run. Planned by a
-//            waypoint job (below; status().detail "planning").
+//            waypoint job (below; status().detail "planning") from the pose
+//            and the encoder payouts, which the devices report with the
+//            drives disabled. Encoder offsets for the payout targets: the
+//            current calibration's, else estimated at the start pose
+//            (waypoint_planner.h). Then the drives are enabled and the
+//            machine waits for operation enabled (enable_timeout_us;
+//            "enabling drives"). Enabled only once the plan exists: no drive
+//            holds torque while the plan is worked out or when there is none,
+//            and a stall of the planning cannot quick-stop a powered drive.
 // move       payout targets sent; waits for motion_finished() (move_timeout_us
 //            is a fault: a winch is stuck).
 // settle     EquilibriumDetector on every new pose; settle_timeout_us without
@@ -52,7 +58,8 @@
 // the hardware and checking for faults, and status and current_waypoint()
 // show what they showed when the job left (plan() is empty meanwhile). A
 // fault or an abort meanwhile ends the run as ever, and the job delivered
-// later is dropped; a new run does not start before the job is back.
+// later is dropped (the run does not go on; plan() shows the waypoints
+// again); a new run does not start before the job is back.
 //
 // Every run is logged in run_log() (docs/FORMATS.md "run.toml"): start and
 // end (utc_now_text), robot time, every waypoint sampled or skipped and why,
@@ -153,7 +160,7 @@ class CalibrationStateMachine {
   void deliver_solve_result(CalibrationResult result, hal::TimeUs now_us);
 
   // Waypoint jobs handed to the owner (WaypointWork::kByOwner). A job
-  // delivered after its run ended is dropped.
+  // delivered after its run ended does not go on with the run.
   bool waypoint_job_pending() const { return job_.has_value(); }
   WaypointJob take_waypoint_job();
   void deliver_waypoint_job(WaypointJob job, hal::TimeUs now_us);
@@ -200,6 +207,8 @@ class CalibrationStateMachine {
   void refresh_device_faults();
   void run_preflight(hal::TimeUs now_us);
   void run_plan(hal::TimeUs now_us);
+  // Commands the drives on, then waits for them (enable_timeout_us) and moves on.
+  void enable_drives(hal::TimeUs now_us);
   void run_move(hal::TimeUs now_us);
   void run_settle(hal::TimeUs now_us);
   void run_sample(hal::TimeUs now_us);
@@ -233,7 +242,9 @@ class CalibrationStateMachine {
 
   CalibrationStatus status_;
   // Per run:
-  std::optional<hal::TimeUs> enable_sent_us_;  // when preflight commanded the drives on
+  bool planned_ = false;
+  std::optional<hal::TimeUs> enable_sent_us_;  // when the drives were commanded on
+  bool drives_enabled_ = false;                // ... and all reported operation enabled
   std::optional<store::CurrentCalibration> previous_;
   WaypointSequence waypoints_;
   std::optional<WaypointJob> job_;       // begun, not taken yet (kByOwner)

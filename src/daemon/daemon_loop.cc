@@ -310,7 +310,7 @@ void DaemonLoop::shutdown() {
     (void)devices_.winches.update(clock_.now_us());
   }
   if (solving_) solve_.wait();  // a fit in progress finishes; its result is dropped
-  if (waypoint_job_.valid()) waypoint_job_.wait();  // likewise a waypoint job
+  if (waypoint_job_.valid()) machine_->deliver_waypoint_job(waypoint_job_.get(), now_us);  // dropped: the run ended
   devices_.winches.close();
   devices_.load_cell.close();
   devices_.pose.close();

@@ -135,12 +135,15 @@ TEST(WaypointJobs, AFaultWhileTheNextWaypointIsChosenStopsTheRunAndTheJobIsDropp
   owner.rig.winches.silence(2, false);
   EXPECT_FALSE(owner.machine->request_start(owner.rig.clock.now_us()));
   EXPECT_TRUE(::cdpr::test::contains(owner.machine->status().note, "still finishing")) << owner.machine->status().note;
-  // AND the job delivered late is dropped: the run stays failed, nothing moves
+  // AND the job delivered late is dropped: the run stays failed, nothing
+  // moves; the run's waypoints are its record again
+  EXPECT_TRUE(owner.machine->plan().waypoints.empty());
   job.run();
   owner.machine->deliver_waypoint_job(std::move(job), owner.rig.clock.now_us());
   owner.step();
   EXPECT_EQ(owner.machine->status().state, CalibrationState::kFailed);
-  EXPECT_TRUE(owner.machine->plan().waypoints.empty());
+  EXPECT_EQ(owner.machine->samples().size(), 2u);
+  EXPECT_FALSE(owner.machine->plan().waypoints.empty());
   EXPECT_EQ(owner.machine->current_waypoint(), nullptr);
   EXPECT_FALSE(owner.machine->waypoint_job_out());
   EXPECT_TRUE(owner.machine->request_start(owner.rig.clock.now_us()));
@@ -155,6 +158,8 @@ TEST(WaypointJobs, AnAbortDuringPlanningHaltsAndDropsThePlan) {
   WaypointJob job = owner.machine->take_waypoint_job();
   owner.step();
   EXPECT_EQ(owner.machine->status().detail, "planning");
+  // (the drives are enabled only once the plan exists)
+  EXPECT_EQ(owner.rig.winches.enables(), 0);
   const int halts = owner.rig.winches.halts();
   // WHEN the operator aborts, and the plan is delivered afterwards
   ASSERT_TRUE(owner.machine->request_abort(owner.rig.clock.now_us()));
@@ -167,8 +172,44 @@ TEST(WaypointJobs, AnAbortDuringPlanningHaltsAndDropsThePlan) {
   EXPECT_EQ(owner.machine->status().state, CalibrationState::kFailed);
   EXPECT_EQ(owner.machine->run_log().outcome, formats::kRunAborted);
   EXPECT_EQ(owner.machine->status().waypoint_count, 0);
-  EXPECT_TRUE(owner.machine->plan().waypoints.empty());
+  EXPECT_EQ(owner.machine->status().waypoint, 0);
   EXPECT_TRUE(owner.rig.winches.all_stopped());
+  EXPECT_EQ(owner.rig.winches.enables(), 0);
+}
+
+TEST(WaypointJobs, TheDrivesAreEnabledOnceThePlanExists) {
+  // GIVEN a run whose planning is away
+  OwnerRig owner(test::rig_options());
+  ASSERT_TRUE(owner.machine->request_start(owner.rig.clock.now_us()));
+  ASSERT_TRUE(owner.step_to_job());
+  WaypointJob job = owner.machine->take_waypoint_job();
+  // WHEN the plan comes back after a while
+  for (int k = 0; k < 50; ++k) owner.step();
+  EXPECT_EQ(owner.rig.winches.enables(), 0);
+  job.run();
+  owner.machine->deliver_waypoint_job(std::move(job), owner.rig.clock.now_us());
+  // THEN the drives are enabled then, and the run moves once they report enabled
+  EXPECT_EQ(owner.rig.winches.enables(), 1);
+  EXPECT_EQ(owner.machine->status().state, CalibrationState::kPlan);
+  EXPECT_EQ(owner.machine->status().detail, "enabling drives");
+  for (int k = 0; k < 100 && owner.machine->status().state == CalibrationState::kPlan; ++k) owner.step();
+  EXPECT_EQ(owner.machine->status().state, CalibrationState::kMove) << owner.machine->status().reason;
+  EXPECT_EQ(owner.machine->status().waypoint, 1);
+}
+
+TEST(WaypointJobs, AnInfeasiblePlanFailsTheRunWithTheDrivesNeverEnabled) {
+  // GIVEN a tension band no waypoint can meet
+  CalibratorOptions options = test::rig_options();
+  options.planner.min_tension_n = 1e6;
+  options.planner.max_tension_n = 2e6;
+  test::CalibrationRig rig(options);
+  // WHEN a run starts
+  ASSERT_TRUE(rig.machine->request_start(rig.clock.now_us()));
+  ASSERT_TRUE(rig.run_to_end());
+  // THEN it fails in planning without a drive ever enabled
+  EXPECT_EQ(rig.status().state, CalibrationState::kFailed);
+  EXPECT_TRUE(::cdpr::test::contains(rig.status().reason, "plan: ")) << rig.status().reason;
+  EXPECT_EQ(rig.winches.enables(), 0);
 }
 
 }  // namespace
