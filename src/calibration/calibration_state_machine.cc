@@ -521,8 +521,6 @@ void CalibrationStateMachine::update_progress() {
   // The sequential strategy counts against its forecast, not its maximum.
   constexpr double kWaypointsStart = 0.05;
   constexpr double kWaypointsSpan = 0.85;
-  if (after_job_ != AfterJob::kNone) return;  // the waypoints are away: the progress as they left
-  const int count = std::max(waypoints_.expected_count(), 1);
   double phase = 0.0;
   switch (status_.state) {
     case CalibrationState::kPreflight: status_.progress = 0.02; return;
@@ -538,6 +536,8 @@ void CalibrationStateMachine::update_progress() {
     case CalibrationState::kAbort:
     case CalibrationState::kFailed: return;
   }
+  if (after_job_ != AfterJob::kNone) return;  // the waypoints are away: the progress as they left
+  const int count = std::max(waypoints_.expected_count(), 1);
   status_.progress = kWaypointsStart + kWaypointsSpan * std::min(1.0, (waypoints_.visited() + phase) / count);
 }
 
