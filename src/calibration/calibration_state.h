@@ -11,8 +11,8 @@ namespace cdpr::calibration {
 
 enum class CalibrationState {
   kIdle,       // nothing run since start-up
-  kPreflight,  // checking nodes, load cell, pose; enabling the drives
-  kPlan,       // planning waypoints from the geometry
+  kPreflight,  // checking nodes, load cell, pose
+  kPlan,       // planning waypoints from the geometry; then enabling the drives
   kMove,       // winches travelling to waypoint k
   kSettle,     // waiting for equilibrium at waypoint k
   kSample,     // averaging the rest window into one sample row

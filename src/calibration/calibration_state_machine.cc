@@ -27,12 +27,14 @@ SolveFunction make_solver_function(CalibrationOptions options) {
 
 CalibrationStateMachine::CalibrationStateMachine(const Robot& robot, CalibratorDevices devices,
                                                  CalibratorOptions options, SolveFunction solve,
-                                                 std::function<std::string()> utc_now_text)
+                                                 std::function<std::string()> utc_now_text,
+                                                 WaypointWork waypoint_work)
     : robot_(robot),
       devices_(devices),
       options_(std::move(options)),
       solve_(std::move(solve)),
       utc_now_text_(std::move(utc_now_text)),
+      waypoint_work_(waypoint_work),
       monitor_(devices.winches, devices.load_cell, devices.pose, options_.monitor),
       detector_(options_.equilibrium, options_.equilibrium_capacity) {}
 
@@ -51,6 +53,11 @@ bool CalibrationStateMachine::request_start(hal::TimeUs now_us) {
                    ")";
     return false;
   }
+  if (job_out_) {
+    // Its result would land in the new run: wait until the worker is done.
+    status_.note = "start refused: the last run's waypoint planning is still finishing, try again";
+    return false;
+  }
   CalibrationStatus fresh;
   fresh.store_problems = std::move(status_.store_problems);
   fresh.pending_commit = status_.pending_commit;
@@ -58,8 +65,13 @@ bool CalibrationStateMachine::request_start(hal::TimeUs now_us) {
   status_.started_us = now_us;
   status_.note = "started";
   enable_sent_us_.reset();
+  drives_enabled_ = false;
+  planned_ = false;
   previous_.reset();
   waypoints_ = WaypointSequence{};
+  job_.reset();
+  after_job_ = AfterJob::kNone;
+  job_waypoint_.reset();
   samples_.clear();
   solve_result_.reset();
   fit_validated_ = false;
@@ -129,6 +141,12 @@ void CalibrationStateMachine::fail(const std::string& reason, hal::TimeUs now_us
                                                   : std::string()) +
                             ")";
   enter(CalibrationState::kAbort, now_us);
+  // A waypoint job still away is dropped when it comes back: the run does
+  // not go on with it. Its waypoints stay the run's record (plan()).
+  if (job_) waypoints_ = std::move(job_->sequence);
+  job_.reset();
+  after_job_ = AfterJob::kNone;
+  job_waypoint_.reset();
   // A fault may mean the robot is not where we think: brake now. An abort
   // request is an operator's choice: decelerate and hold.
   hal::Status stopped = fault ? devices_.winches.quick_stop() : devices_.winches.halt();
@@ -174,9 +192,9 @@ void CalibrationStateMachine::step(hal::TimeUs now_us) {
         return;
       }
     }
-    const bool drives_enabled = state != CalibrationState::kPreflight;
-    if (std::string fault = monitor_.check(now_us, drives_enabled); !fault.empty()) return fail(fault, now_us, true);
+    if (std::string fault = monitor_.check(now_us, drives_enabled_); !fault.empty()) return fail(fault, now_us, true);
   }
+  if (after_job_ != AfterJob::kNone) return;  // the waypoint job is away: status as it left
   switch (state) {
     case CalibrationState::kPreflight: run_preflight(now_us); break;
     case CalibrationState::kPlan: run_plan(now_us); break;
@@ -195,19 +213,23 @@ void CalibrationStateMachine::step(hal::TimeUs now_us) {
 }
 
 void CalibrationStateMachine::run_preflight(hal::TimeUs now_us) {
+  // Before anything moves: a run whose fit could not be committed would be wasted.
+  if (const auto probed = devices_.store.probe_writable(); !probed) {
+    return fail("the store cannot be written (" + probed.error().message() + "): a fit could not be committed",
+                now_us, false);
+  }
+  auto current = devices_.store.load_current();
+  if (current) {
+    previous_ = std::move(*current);
+  } else {
+    status_.note = "current calibration unreadable (" + current.error().message() +
+                   "): calibrating without the change check";
+  }
+  enter(CalibrationState::kPlan, now_us);
+}
+
+void CalibrationStateMachine::enable_drives(hal::TimeUs now_us) {
   if (!enable_sent_us_) {
-    // Before anything moves: a run whose fit could not be committed would be wasted.
-    if (const auto probed = devices_.store.probe_writable(); !probed) {
-      return fail("the store cannot be written (" + probed.error().message() + "): a fit could not be committed",
-                  now_us, false);
-    }
-    auto current = devices_.store.load_current();
-    if (current) {
-      previous_ = std::move(*current);
-    } else {
-      status_.note = "current calibration unreadable (" + current.error().message() +
-                     "): calibrating without the change check";
-    }
     if (const hal::Status s = devices_.winches.enable(); !s.ok()) return fail("enable: " + s.to_string(), now_us, true);
     enable_sent_us_ = now_us;
     status_.detail = "enabling drives";
@@ -224,10 +246,15 @@ void CalibrationStateMachine::run_preflight(hal::TimeUs now_us) {
       return;
     }
   }
-  enter(CalibrationState::kPlan, now_us);
+  drives_enabled_ = true;
+  targets_sent_ = false;
+  enter(CalibrationState::kMove, now_us);
+  status_.waypoint = 1;
 }
 
 void CalibrationStateMachine::run_plan(hal::TimeUs now_us) {
+  // The drives are enabled once the plan exists (the header says why).
+  if (planned_) return enable_drives(now_us);
   const Readings& readings = monitor_.readings();
   const Eigen::Vector3d start_world(readings.pose->platform_world.x, readings.pose->platform_world.y,
                                     readings.pose->platform_world.z);
@@ -250,18 +277,22 @@ void CalibrationStateMachine::run_plan(hal::TimeUs now_us) {
   SequentialOptions sequential = options_.sequential;
   sequential.min_count = options_.validation.min_samples;
   sequential.settle_s = expected_settle_s(options_.equilibrium);
-  if (const std::string problem = waypoints_.start(planning_robot, offsets_m, start_world, options_.planner,
-                                                   options_.strategy, sequential, now_us);
-      !problem.empty()) {
-    return fail("plan: " + problem, now_us, false);
-  }
+  begin_job(AfterJob::kPlanned,
+            [planning_robot, offsets_m, start_world, planner = options_.planner, strategy = options_.strategy,
+             sequential, now_us](WaypointSequence& waypoints) {
+              return waypoints.start(planning_robot, offsets_m, start_world, planner, strategy, sequential, now_us);
+            },
+            now_us);
+}
+
+void CalibrationStateMachine::after_plan(const std::string& problem, hal::TimeUs now_us) {
+  if (!problem.empty()) return fail("plan: " + problem, now_us, false);
   status_.waypoint_count = waypoints_.planned();
   run_log_.waypoints_planned = status_.waypoint_count;
   update_waypoint_status();
   log_run(now_us);
-  targets_sent_ = false;
-  enter(CalibrationState::kMove, now_us);
-  status_.waypoint = 1;
+  planned_ = true;
+  enable_drives(now_us);
 }
 
 void CalibrationStateMachine::run_move(hal::TimeUs now_us) {
@@ -316,9 +347,12 @@ void CalibrationStateMachine::run_settle(hal::TimeUs now_us) {
                                   "no equilibrium within " + seconds(options_.settle_timeout_us) + " (" +
                                       status_.detail + ")"});
     run_log_.skipped = status_.skipped;
-    waypoints_.skipped(now_us);
-    log_run(now_us);
-    next_waypoint(now_us);
+    begin_job(AfterJob::kSkipped,
+              [now_us](WaypointSequence& waypoints) {
+                waypoints.skipped(now_us);
+                return std::string();
+              },
+              now_us);
   }
 }
 
@@ -328,13 +362,71 @@ void CalibrationStateMachine::run_sample(hal::TimeUs now_us) {
   sample.id = static_cast<int>(samples_.size());
   samples_.push_back(sample);
   status_.samples = static_cast<int>(samples_.size());
-  waypoints_.sampled(sample, now_us);
+  begin_job(AfterJob::kSampled,
+            [sample = std::move(sample), now_us](WaypointSequence& waypoints) {
+              waypoints.sampled(sample, now_us);
+              return std::string();
+            },
+            now_us);
+}
+
+void CalibrationStateMachine::after_sample(hal::TimeUs now_us) {
   // A remark on how the next waypoint was chosen (a failed re-solve) goes with this one.
   if (!waypoints_.remark().empty()) status_.note = waypoints_.remark();
-  run_log_.waypoints.push_back({status_.waypoint, "sampled", run_seconds(now_us), sample.id, waypoints_.remark()});
+  run_log_.waypoints.push_back(
+      {status_.waypoint, "sampled", run_seconds(job_begun_us_), samples_.back().id, waypoints_.remark()});
   run_log_.samples = status_.samples;
-  log_run(now_us);
+  log_run(job_begun_us_);
   next_waypoint(now_us);
+}
+
+void CalibrationStateMachine::begin_job(AfterJob after, std::function<std::string(WaypointSequence&)> work,
+                                        hal::TimeUs now_us) {
+  const Waypoint* at = current_waypoint();
+  job_waypoint_ = at ? std::optional<Waypoint>(*at) : std::nullopt;
+  WaypointJob job{std::move(waypoints_), std::move(work), {}};
+  waypoints_ = WaypointSequence{};
+  after_job_ = after;
+  job_begun_us_ = now_us;
+  status_.detail = after == AfterJob::kPlanned ? "planning" : "choosing the next waypoint";
+  if (waypoint_work_ == WaypointWork::kInline) {
+    job.run();
+    return finish_job(std::move(job), now_us);
+  }
+  job_ = std::move(job);
+}
+
+WaypointJob CalibrationStateMachine::take_waypoint_job() {
+  WaypointJob job = std::move(*job_);
+  job_.reset();
+  job_out_ = true;
+  return job;
+}
+
+void CalibrationStateMachine::deliver_waypoint_job(WaypointJob job, hal::TimeUs now_us) {
+  job_out_ = false;
+  if (after_job_ == AfterJob::kNone) {
+    // The run ended meanwhile: it does not go on; plan() shows its waypoints again.
+    waypoints_ = std::move(job.sequence);
+    return;
+  }
+  finish_job(std::move(job), now_us);
+}
+
+void CalibrationStateMachine::finish_job(WaypointJob job, hal::TimeUs now_us) {
+  waypoints_ = std::move(job.sequence);
+  const AfterJob after = std::exchange(after_job_, AfterJob::kNone);
+  job_waypoint_.reset();
+  switch (after) {
+    case AfterJob::kPlanned: after_plan(job.problem, now_us); break;
+    case AfterJob::kSampled: after_sample(now_us); break;
+    case AfterJob::kSkipped:
+      log_run(job_begun_us_);
+      next_waypoint(now_us);
+      break;
+    case AfterJob::kNone: break;
+  }
+  update_progress();
 }
 
 void CalibrationStateMachine::next_waypoint(hal::TimeUs now_us) {
@@ -429,7 +521,6 @@ void CalibrationStateMachine::update_progress() {
   // The sequential strategy counts against its forecast, not its maximum.
   constexpr double kWaypointsStart = 0.05;
   constexpr double kWaypointsSpan = 0.85;
-  const int count = std::max(waypoints_.expected_count(), 1);
   double phase = 0.0;
   switch (status_.state) {
     case CalibrationState::kPreflight: status_.progress = 0.02; return;
@@ -445,6 +536,8 @@ void CalibrationStateMachine::update_progress() {
     case CalibrationState::kAbort:
     case CalibrationState::kFailed: return;
   }
+  if (after_job_ != AfterJob::kNone) return;  // the waypoints are away: the progress as they left
+  const int count = std::max(waypoints_.expected_count(), 1);
   status_.progress = kWaypointsStart + kWaypointsSpan * std::min(1.0, (waypoints_.visited() + phase) / count);
 }
 
@@ -452,7 +545,8 @@ const Waypoint* CalibrationStateMachine::current_waypoint() const {
   const CalibrationState state = status_.state;
   const bool at_waypoint =
       state == CalibrationState::kMove || state == CalibrationState::kSettle || state == CalibrationState::kSample;
-  return at_waypoint ? waypoints_.current() : nullptr;
+  if (!at_waypoint) return nullptr;
+  return after_job_ != AfterJob::kNone ? (job_waypoint_ ? &*job_waypoint_ : nullptr) : waypoints_.current();
 }
 
 void CalibrationStateMachine::update_waypoint_status() {

@@ -9,21 +9,29 @@
 //
 // preflight  the store proves it can write (a run it could not commit is
 //            not started); every winch alive, pose fresh and valid, load cell
-//            answering and the tension inside its limits; enable the drives and wait for
-//            operation enabled (enable_timeout_us). Encoder offsets for the
-//            payout targets: the current calibration's, else estimated at the
-//            start pose (waypoint_planner.h).
+//            answering and the tension inside its limits. The drives stay
+//            disabled.
 // plan       the waypoints (waypoint_sequence.h) with the current
 //            calibration's anchors when one exists, else the nominal ones: a
 //            fixed plan (spread, informative) or the sequential strategy's
-//            candidates; an infeasible plan fails the run.
+//            candidates; an infeasible plan fails the run. Planned by a
+//            waypoint job (below; status().detail "planning") from the pose
+//            and the encoder payouts, which the devices report with the
+//            drives disabled. Encoder offsets for the payout targets: the
+//            current calibration's, else estimated at the start pose
+//            (waypoint_planner.h). Then the drives are enabled and the
+//            machine waits for operation enabled (enable_timeout_us;
+//            "enabling drives"). Enabled only once the plan exists: no drive
+//            holds torque while the plan is worked out or when there is none,
+//            and a stall of the planning cannot quick-stop a powered drive.
 // move       payout targets sent; waits for motion_finished() (move_timeout_us
 //            is a fault: a winch is stuck).
 // settle     EquilibriumDetector on every new pose; settle_timeout_us without
 //            equilibrium skips the waypoint (noted), it is not a fault.
 // sample     the window's average becomes one sample row. The sequential
 //            strategy re-solves with the rows so far and picks the next
-//            waypoint here (milliseconds: inside step()); when its stop rule
+//            waypoint in a waypoint job (status().detail "choosing the next
+//            waypoint"; a skip in settle does the same); when its stop rule
 //            ends the waypoints, the run goes on to solve.
 // solve      after the last waypoint the winches are halted (hold). With a
 //            SolveFunction the solve runs inside step(); without, the owner
@@ -40,6 +48,18 @@
 // abort      quick stop for a fault, halt (decelerate and hold) for an abort
 //            request; the reason goes to status().reason and, as the latest
 //            remark, to status().note.
+//
+// Waypoint jobs (waypoint_job.h): planning and choosing the next waypoint
+// can take seconds (a large candidate grid, the robust stages of a re-solve
+// working through a gross error). With WaypointWork::kInline they run inside
+// step(). With kByOwner the owner takes the job (waypoint_job_pending(),
+// take_waypoint_job()), runs it wherever it likes (a worker thread) and
+// hands it back (deliver_waypoint_job()); meanwhile step() goes on polling
+// the hardware and checking for faults, and status and current_waypoint()
+// show what they showed when the job left (plan() is empty meanwhile). A
+// fault or an abort meanwhile ends the run as ever, and the job delivered
+// later is dropped (the run does not go on; plan() shows the waypoints
+// again); a new run does not start before the job is back.
 //
 // Every run is logged in run_log() (docs/FORMATS.md "run.toml"): start and
 // end (utc_now_text), robot time, every waypoint sampled or skipped and why,
@@ -68,6 +88,7 @@
 #include "src/calibration/equilibrium_detector.h"
 #include "src/calibration/fit_validation.h"
 #include "src/calibration/hardware_monitor.h"
+#include "src/calibration/waypoint_job.h"
 #include "src/calibration/waypoint_planner.h"
 #include "src/calibration/waypoint_sequence.h"
 #include "src/formats/run_log_toml.h"
@@ -114,9 +135,11 @@ struct CalibratorDevices {
 class CalibrationStateMachine {
  public:
   // `utc_now_text` gives calibration.toml's `created` (RFC 3339 UTC); the
-  // state machine never reads a clock itself. `solve` may be empty (see above).
+  // state machine never reads a clock itself. `solve` may be empty and
+  // `waypoint_work` says where the waypoint jobs run (see above).
   CalibrationStateMachine(const Robot& robot, CalibratorDevices devices, CalibratorOptions options,
-                          SolveFunction solve, std::function<std::string()> utc_now_text);
+                          SolveFunction solve, std::function<std::string()> utc_now_text,
+                          WaypointWork waypoint_work = WaypointWork::kInline);
 
   // Advances the machine; call periodically (e.g. every 20 ms) with monotonic time.
   void step(hal::TimeUs now_us);
@@ -135,6 +158,14 @@ class CalibrationStateMachine {
   bool solve_pending() const;
   const std::vector<Sample>& samples() const { return samples_; }
   void deliver_solve_result(CalibrationResult result, hal::TimeUs now_us);
+
+  // Waypoint jobs handed to the owner (WaypointWork::kByOwner). A job
+  // delivered after its run ended does not go on with the run.
+  bool waypoint_job_pending() const { return job_.has_value(); }
+  WaypointJob take_waypoint_job();
+  void deliver_waypoint_job(WaypointJob job, hal::TimeUs now_us);
+  // A job was taken and is not back yet.
+  bool waypoint_job_out() const { return job_out_; }
 
   // True while step() polls the devices (preflight .. sample).
   bool owns_hardware() const;
@@ -162,7 +193,8 @@ class CalibrationStateMachine {
   const CalibrationResult* validated_result() const { return fit_validated_ ? &*solve_result_ : nullptr; }
 
   const CalibrationStatus& status() const { return status_; }
-  // The fixed plan's waypoints in travel order, or the sequential strategy's candidates.
+  // The fixed plan's waypoints in travel order, or the sequential strategy's
+  // candidates; empty while a waypoint job is away.
   const WaypointPlan& plan() const { return waypoints_.plan(); }
   // The waypoint being worked on (move .. sample); null otherwise.
   const Waypoint* current_waypoint() const;
@@ -175,10 +207,19 @@ class CalibrationStateMachine {
   void refresh_device_faults();
   void run_preflight(hal::TimeUs now_us);
   void run_plan(hal::TimeUs now_us);
+  // Commands the drives on, then waits for them (enable_timeout_us) and moves on.
+  void enable_drives(hal::TimeUs now_us);
   void run_move(hal::TimeUs now_us);
   void run_settle(hal::TimeUs now_us);
   void run_sample(hal::TimeUs now_us);
   void next_waypoint(hal::TimeUs now_us);
+  // What the run does once a waypoint job is back.
+  enum class AfterJob { kNone, kPlanned, kSampled, kSkipped };
+  // Moves the waypoints into a job running `work`: inline, or for the owner.
+  void begin_job(AfterJob after, std::function<std::string(WaypointSequence&)> work, hal::TimeUs now_us);
+  void finish_job(WaypointJob job, hal::TimeUs now_us);
+  void after_plan(const std::string& problem, hal::TimeUs now_us);
+  void after_sample(hal::TimeUs now_us);
   void run_solve(hal::TimeUs now_us);
   void run_validate_and_commit(hal::TimeUs now_us);
   // Keeps a fit whose commit failed in <state>/pending; the sentence for the reason.
@@ -195,14 +236,22 @@ class CalibrationStateMachine {
   CalibratorOptions options_;
   SolveFunction solve_;
   std::function<std::string()> utc_now_text_;
+  WaypointWork waypoint_work_;
   HardwareMonitor monitor_;
   EquilibriumDetector detector_;
 
   CalibrationStatus status_;
   // Per run:
-  std::optional<hal::TimeUs> enable_sent_us_;  // when preflight commanded the drives on
+  bool planned_ = false;
+  std::optional<hal::TimeUs> enable_sent_us_;  // when the drives were commanded on
+  bool drives_enabled_ = false;                // ... and all reported operation enabled
   std::optional<store::CurrentCalibration> previous_;
   WaypointSequence waypoints_;
+  std::optional<WaypointJob> job_;       // begun, not taken yet (kByOwner)
+  bool job_out_ = false;                 // taken, not delivered yet (outlives its run)
+  AfterJob after_job_ = AfterJob::kNone;  // a job of this run is away
+  hal::TimeUs job_begun_us_ = 0;
+  std::optional<Waypoint> job_waypoint_;  // current_waypoint() while the job is away
   bool targets_sent_ = false;
   std::vector<Sample> samples_;
   std::optional<CalibrationResult> solve_result_;

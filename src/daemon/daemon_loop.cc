@@ -40,11 +40,13 @@ DaemonLoop::DaemonLoop(const DaemonConfig& config, const Robot& robot, DaemonDev
                        std::function<void(const std::string&)> log)
     : config_(config), robot_(robot), devices_(devices), store_(store), clock_(clock), notifier_(notifier),
       log_(std::move(log)), run_marker_(store.state_dir()) {
-  // No SolveFunction: the loop runs the fit on a worker thread (manage_solve).
+  // No SolveFunction and waypoint jobs by the owner: the loop runs the fit and
+  // the waypoint planning on worker threads (manage_solve, manage_waypoint_job).
   machine_ = std::make_unique<calibration::CalibrationStateMachine>(
       robot_,
       calibration::CalibratorDevices{devices_.winches, devices_.load_cell, devices_.pose, devices_.button, store_},
-      calibrator_options(config_), calibration::SolveFunction{}, utc_now_rfc3339);
+      calibrator_options(config_), calibration::SolveFunction{}, utc_now_rfc3339,
+      calibration::WaypointWork::kByOwner);
   constexpr double kBytesPerMb = 1e6;
   std::optional<DiagnosisOptions> model_check;
   if (config_.history.model_check) {
@@ -187,6 +189,7 @@ void DaemonLoop::run_once() {
 void DaemonLoop::step(hal::TimeUs now_us) {
   if (!machine_->owns_hardware()) service_idle_devices(now_us);
   machine_->step(now_us);
+  manage_waypoint_job(now_us);
   manage_solve(now_us);
   manage_refit();
   track_run();
@@ -250,6 +253,20 @@ void DaemonLoop::manage_solve(hal::TimeUs now_us) {
   });
 }
 
+void DaemonLoop::manage_waypoint_job(hal::TimeUs now_us) {
+  if (waypoint_job_.valid()) {
+    if (waypoint_job_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+    // Dropped by the machine when its run ended meanwhile.
+    machine_->deliver_waypoint_job(waypoint_job_.get(), now_us);
+  }
+  if (!machine_->waypoint_job_pending()) return;
+  // The job owns the run's waypoints and copies of its inputs: nothing shared.
+  waypoint_job_ = std::async(std::launch::async, [job = machine_->take_waypoint_job()]() mutable {
+    job.run();
+    return std::move(job);
+  });
+}
+
 void DaemonLoop::manage_refit() {
   if (!refitter_->poll(calibration::is_running(machine_->status().state))) return;
   std::optional<CommittedRefit> committed = refitter_->take_committed();
@@ -293,6 +310,7 @@ void DaemonLoop::shutdown() {
     (void)devices_.winches.update(clock_.now_us());
   }
   if (solving_) solve_.wait();  // a fit in progress finishes; its result is dropped
+  if (waypoint_job_.valid()) machine_->deliver_waypoint_job(waypoint_job_.get(), now_us);  // dropped: the run ended
   devices_.winches.close();
   devices_.load_cell.close();
   devices_.pose.close();

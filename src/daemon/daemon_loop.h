@@ -9,6 +9,12 @@
 //   - steps the CalibrationStateMachine with monotonic time (hal::Clock),
 //   - runs the solve on a worker thread when the machine asks for it, so
 //     the loop, the socket and the watchdog stay alive during a long fit,
+//   - runs the machine's waypoint jobs (planning, the sequential strategy's
+//     re-solve and choice of the next waypoint) on a worker thread too: the
+//     drives are enabled then, and the machine's step keeps polling them
+//     (the CANopen master's heartbeat goes out in the winch bank's update;
+//     the drives quick-stop when it pauses for consumer_heartbeat_ms), the
+//     pose and the load cell and keeps checking for faults,
 //   - when the machine does not own the devices: keeps the CAN bus and the
 //     pose stream drained and reconnects devices that are not open (every
 //     kReconnectIntervalUs), so a start finds fresh data,
@@ -27,7 +33,8 @@
 //
 // Ownership: devices, store and clock are the owner's and must outlive the
 // loop; the loop opens and closes the devices. Not thread-safe apart from
-// the internal solve thread; one thread calls everything.
+// the internal solve and waypoint threads, which get copies (or the moved
+// WaypointSequence) and share nothing with the loop; one thread calls everything.
 
 #include <atomic>
 #include <functional>
@@ -100,6 +107,8 @@ class DaemonLoop {
   void step(hal::TimeUs now_us);
   void service_idle_devices(hal::TimeUs now_us);
   void manage_solve(hal::TimeUs now_us);
+  // Runs the machine's waypoint job on a worker and delivers it back.
+  void manage_waypoint_job(hal::TimeUs now_us);
   // A refit's result taken, logged and, when committed, kept in the history.
   void manage_refit();
   void report(hal::TimeUs now_us);
@@ -128,6 +137,7 @@ class DaemonLoop {
   std::unique_ptr<RunRefitter> refitter_;
   std::future<CalibrationResult> solve_;
   bool solving_ = false;
+  std::future<calibration::WaypointJob> waypoint_job_;  // valid while a job is on the worker
 
   bool winches_open_ = false, load_cell_open_ = false, pose_open_ = false;
   std::string winches_error_, load_cell_error_, pose_error_;  // last logged open failure

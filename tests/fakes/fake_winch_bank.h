@@ -3,7 +3,9 @@
 // its target at a fixed speed as the injected time passes between update()
 // calls; commands take effect at the next update(), like the real drives.
 // Faults are injected per winch: a silent node (heartbeat stops, the winch is
-// dead after the heartbeat timeout), a drive fault, failing sends.
+// dead after the heartbeat timeout), a drive fault, failing sends. The drives
+// may watch the master's heartbeat, which the real bank sends from update():
+// a longer pause between two update() calls quick-stops them.
 // Observers (moving(), all_stopped(), quick_stops()) let tests check the end
 // state ("winches stopped") rather than a recorded call sequence.
 
@@ -25,6 +27,9 @@ class FakeWinchBank final : public hal::WinchBank {
     double speed_m_per_s = 0.5;            // profile speed of every winch
     double reached_tolerance_m = 1e-4;     // target reached within this
     hal::TimeUs heartbeat_timeout_us = 300'000;
+    // The drives' consumer heartbeat time (0x1016 with abort connection
+    // option 3: quick stop); 0: not watched.
+    hal::TimeUs consumer_heartbeat_us = 0;
   };
 
   FakeWinchBank() : FakeWinchBank(Options{}) {}
@@ -67,6 +72,9 @@ class FakeWinchBank final : public hal::WinchBank {
   int quick_stops() const { return quick_stops_; }
   int enables() const { return enables_; }  // enable() commands accepted
   int halts() const { return halts_; }
+  int updates() const { return updates_; }
+  // Times the drives quick-stopped because update() paused too long.
+  int heartbeat_losses() const { return heartbeat_losses_; }
 
   // ---- hal::WinchBank ----
   int winch_count() const override { return options_.winch_count; }
@@ -82,6 +90,15 @@ class FakeWinchBank final : public hal::WinchBank {
     if (!open_) return not_open();
     if (!io_error_.ok()) return io_error_;
     const double dt_s = last_update_us_ < 0 ? 0.0 : 1e-6 * static_cast<double>(now_us - last_update_us_);
+    ++updates_;
+    if (options_.consumer_heartbeat_us > 0 && last_update_us_ >= 0 &&
+        now_us - last_update_us_ > options_.consumer_heartbeat_us) {
+      ++heartbeat_losses_;
+      for (Winch& w : winches_) {
+        if (w.state == hal::DriveState::kEnabled) w.state = hal::DriveState::kQuickStop;
+        w.target_m = w.payout_m;
+      }
+    }
     last_update_us_ = now_us;
     now_us_ = now_us;
     for (Winch& w : winches_) step(w, dt_s, now_us);
@@ -174,6 +191,8 @@ class FakeWinchBank final : public hal::WinchBank {
     hal::TimeUs last_heard_us = -1;
   };
   int fault_resets_ = 0;
+  int updates_ = 0;
+  int heartbeat_losses_ = 0;
 
   Winch& at(int winch) {
     if (winch < 0 || winch >= options_.winch_count) std::abort();  // as the real bank: broken invariant
