@@ -12,9 +12,14 @@ namespace {
 
 std::string seconds(hal::TimeUs duration_us) { return significant(1e-6 * static_cast<double>(duration_us), 3) + " s"; }
 
+// At a waypoint (moving to it, settling, sampling): the drives were enabled
+// before the first move and stay so until the run ends.
+bool at_waypoint(CalibrationState state) {
+  return state == CalibrationState::kMove || state == CalibrationState::kSettle || state == CalibrationState::kSample;
+}
+
 bool in_motion_phase(CalibrationState state) {
-  return state == CalibrationState::kPreflight || state == CalibrationState::kPlan ||
-         state == CalibrationState::kMove || state == CalibrationState::kSettle || state == CalibrationState::kSample;
+  return state == CalibrationState::kPreflight || state == CalibrationState::kPlan || at_waypoint(state);
 }
 
 }  // namespace
@@ -65,8 +70,6 @@ bool CalibrationStateMachine::request_start(hal::TimeUs now_us) {
   status_.started_us = now_us;
   status_.note = "started";
   enable_sent_us_.reset();
-  drives_enabled_ = false;
-  planned_ = false;
   previous_.reset();
   waypoints_ = WaypointSequence{};
   job_.reset();
@@ -192,7 +195,7 @@ void CalibrationStateMachine::step(hal::TimeUs now_us) {
         return;
       }
     }
-    if (std::string fault = monitor_.check(now_us, drives_enabled_); !fault.empty()) return fail(fault, now_us, true);
+    if (std::string fault = monitor_.check(now_us, at_waypoint(state)); !fault.empty()) return fail(fault, now_us, true);
   }
   if (after_job_ != AfterJob::kNone) return;  // the waypoint job is away: status as it left
   switch (state) {
@@ -246,15 +249,15 @@ void CalibrationStateMachine::enable_drives(hal::TimeUs now_us) {
       return;
     }
   }
-  drives_enabled_ = true;
   targets_sent_ = false;
   enter(CalibrationState::kMove, now_us);
   status_.waypoint = 1;
 }
 
 void CalibrationStateMachine::run_plan(hal::TimeUs now_us) {
-  // The drives are enabled once the plan exists (the header says why).
-  if (planned_) return enable_drives(now_us);
+  // The drives are enabled once the plan exists (the header says why):
+  // after_plan() sent the enable.
+  if (enable_sent_us_) return enable_drives(now_us);
   const Readings& readings = monitor_.readings();
   const Eigen::Vector3d start_world(readings.pose->platform_world.x, readings.pose->platform_world.y,
                                     readings.pose->platform_world.z);
@@ -291,7 +294,6 @@ void CalibrationStateMachine::after_plan(const std::string& problem, hal::TimeUs
   run_log_.waypoints_planned = status_.waypoint_count;
   update_waypoint_status();
   log_run(now_us);
-  planned_ = true;
   enable_drives(now_us);
 }
 
@@ -542,10 +544,7 @@ void CalibrationStateMachine::update_progress() {
 }
 
 const Waypoint* CalibrationStateMachine::current_waypoint() const {
-  const CalibrationState state = status_.state;
-  const bool at_waypoint =
-      state == CalibrationState::kMove || state == CalibrationState::kSettle || state == CalibrationState::kSample;
-  if (!at_waypoint) return nullptr;
+  if (!at_waypoint(status_.state)) return nullptr;
   return after_job_ != AfterJob::kNone ? (job_waypoint_ ? &*job_waypoint_ : nullptr) : waypoints_.current();
 }
 

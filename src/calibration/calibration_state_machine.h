@@ -242,9 +242,7 @@ class CalibrationStateMachine {
 
   CalibrationStatus status_;
   // Per run:
-  bool planned_ = false;
-  std::optional<hal::TimeUs> enable_sent_us_;  // when the drives were commanded on
-  bool drives_enabled_ = false;                // ... and all reported operation enabled
+  std::optional<hal::TimeUs> enable_sent_us_;  // when the drives were commanded on (the plan exists)
   std::optional<store::CurrentCalibration> previous_;
   WaypointSequence waypoints_;
   std::optional<WaypointJob> job_;       // begun, not taken yet (kByOwner)

@@ -11,10 +11,11 @@
 //     the loop, the socket and the watchdog stay alive during a long fit,
 //   - runs the machine's waypoint jobs (planning, the sequential strategy's
 //     re-solve and choice of the next waypoint) on a worker thread too: the
-//     drives are enabled then, and the machine's step keeps polling them
-//     (the CANopen master's heartbeat goes out in the winch bank's update;
-//     the drives quick-stop when it pauses for consumer_heartbeat_ms), the
-//     pose and the load cell and keeps checking for faults,
+//     drives are enabled during the re-solves, and the machine's step keeps
+//     polling them (the CANopen master's heartbeat goes out in the winch
+//     bank's update; the drives quick-stop when it pauses for
+//     consumer_heartbeat_ms), the pose and the load cell and keeps checking
+//     for faults,
 //   - when the machine does not own the devices: keeps the CAN bus and the
 //     pose stream drained and reconnects devices that are not open (every
 //     kReconnectIntervalUs), so a start finds fresh data,
