@@ -4,6 +4,7 @@
 // (Eq. 14) and the load cell (Eq. 16). The attachment-height rows between
 // them (Eq. 15) are a model identity, not a reading.
 
+#include <algorithm>
 #include <array>
 
 #include "solver/model/robot.h"
@@ -22,6 +23,7 @@ static_assert(kCableCount == 4, "kReadingRows lists four encoder rows");
 struct LeftOutRows {
   std::array<int, kCableCount + 1> rows{};
   int count = 0;
+  bool contains(int row) const { return std::find(rows.begin(), rows.begin() + count, row) != rows.begin() + count; }
 };
 inline LeftOutRows left_out_rows(const Sample& sample) {
   LeftOutRows out;

@@ -8,7 +8,7 @@
 #include <Eigen/Cholesky>
 
 #include "solver/calibration/effect_pose_factor.h"
-#include "solver/calibration/pose_prior_factor.h"
+#include "solver/calibration/fitted_row_factors.h"
 #include "solver/linalg/block_copy.h"
 #include "solver/linalg/dense_kernels.h"
 #include "solver/linalg/group_kernels.h"
@@ -308,10 +308,7 @@ bool studentise(const Robot& robot, const Sample& sample, const RowJacobian& j, 
   const LeftOutRows left_out = left_out_rows(sample);
   for (int reading = 0; reading <= kCableCount; ++reading) {
     const int r = kReadingRows[reading];
-    if (std::find(left_out.rows.begin(), left_out.rows.begin() + left_out.count, r) !=
-        left_out.rows.begin() + left_out.count) {
-      continue;
-    }
+    if (left_out.contains(r)) continue;
     const Eigen::Matrix<double, kRowUnknowns, 1> jr = j.row(r).transpose();
     const bool force_row = reading == kCableCount;
     out.push_back({{sample.id, force_row ? SensorKind::kForce : SensorKind::kEncoder,
@@ -371,10 +368,7 @@ double largest_studentised_residual(const Sample& sample, std::span<const double
   const LeftOutRows left_out = left_out_rows(sample);
   double largest = 0.0;
   for (int r : kReadingRows) {
-    if (std::find(left_out.rows.begin(), left_out.rows.begin() + left_out.count, r) !=
-        left_out.rows.begin() + left_out.count) {
-      continue;
-    }
+    if (left_out.contains(r)) continue;
     std::array<double, kRowUnknowns> w;
     std::copy_n(local.data() + r * kRowUnknowns, kRowUnknowns, w.data());
     group_kernels::solve_upper_transposed<kRowUnknowns>(u.data(), inverse.data(), kRowUnknowns, w.data());
@@ -427,18 +421,9 @@ std::vector<SensorReading> hidden_gross_errors(const Robot& robot, const Calibra
     // A row the fit's own linearisation puts clearly below the bar has
     // no reading to name.
     if (row.largest_studentised * (1.0 + kScreenMargin) < bar_sigma) continue;
-    const Eigen::Vector3d& p = row.world_T_platform.position_world;
-    const Eigen::Quaterniond& q = row.world_T_platform.world_R_platform;
-    pose = {p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z()};
-    force = {row.reference_force(0), row.reference_force(1)};
-    const SampleSigmas sigma = reading_sigmas(robot, row.sample);
-    const int index = static_cast<int>(k);
-    const PosePriorFactor prior(index, {row.sample.position_world, row.sample.world_R_platform}, sigma.position_m,
-                                sigma.orientation_rad, loss);
-    const EffectPoseFactor factor(robot, index, row.sample, options.height_sigma_m, loss, options.effects);
-    double cost = 0.0;
-    if (!prior.evaluate(parameters.data(), prior_residual.data(), prior_jacobians, &cost) ||
-        !factor.evaluate(parameters.data(), residual.data(), jacobians.data(), &cost)) {
+    if (!evaluate_fitted_row(robot, row, static_cast<int>(k), options.height_sigma_m, loss, options.effects,
+                             pose.data(), force.data(), parameters.data(),
+                             {prior_residual.data(), prior_jacobians, residual.data(), jacobians.data()})) {
       continue;
     }
     if (!studentise(robot, row.sample,

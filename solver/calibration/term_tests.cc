@@ -12,7 +12,7 @@
 
 #include "solver/calibration/chi_square.h"
 #include "solver/calibration/effect_pose_factor.h"
-#include "solver/calibration/pose_prior_factor.h"
+#include "solver/calibration/fitted_row_factors.h"
 #include "solver/linalg/block_copy.h"
 #include "solver/linalg/dense_kernels.h"
 #include "solver/linalg/group_kernels.h"
@@ -144,18 +144,11 @@ bool reduce(const Robot& robot, const CalibrationOptions& options, const Calibra
   out.gradient = Eigen::VectorXd::Zero(g);
   const int n = static_cast<int>(result.fitted_rows.size());
   for (int k = 0; k < n; ++k) {
-    const FittedRow& row = result.fitted_rows[k];
-    const Eigen::Vector3d& p = row.world_T_platform.position_world;
-    const Eigen::Quaterniond& q = row.world_T_platform.world_R_platform;
-    pose = {p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z()};
-    force = {row.reference_force(0), row.reference_force(1)};
-    const SampleSigmas sigma = reading_sigmas(robot, row.sample);
-    const PosePriorFactor prior(k, {row.sample.position_world, row.sample.world_R_platform}, sigma.position_m,
-                                sigma.orientation_rad, loss);
-    const EffectPoseFactor factor(robot, k, row.sample, options.height_sigma_m, loss, x.effects);
-    double cost = 0.0;
-    if (!prior.evaluate(parameters.data(), prior_residual.data(), prior_jacobians, &cost)) return false;
-    if (!factor.evaluate(parameters.data(), residual.data(), jacobians.data(), &cost)) return false;
+    if (!evaluate_fitted_row(robot, result.fitted_rows[k], k, options.height_sigma_m, loss, x.effects, pose.data(),
+                             force.data(), parameters.data(),
+                             {prior_residual.data(), prior_jacobians, residual.data(), jacobians.data()})) {
+      return false;
+    }
     for (std::size_t b = 0; b < blocks.size(); ++b) {
       const int d = block_dims[b];
       const int column = b == 0 ? 0 : b == 1 ? 6 : block_column[b];
