@@ -278,16 +278,22 @@ CalibrationResult calibrate_once(const Robot& robot, const std::vector<Sample>& 
   const LossFunction final_loss{LossKind::kHuber, options.huber_width};
   // On clean data the robust stage ends where its loss and the final one
   // are both quadratic at every reading: its last linearisation is the
-  // final fit's first.
-  if (options.robust && same_linearization(built, lm, *built.reading_loss, final_loss, catenary)) {
-    lm.reuse_last_linearization();
-  }
+  // final fit's first. When the robust stage also converged there, that
+  // point is the final fit's minimum: the final cost, gradient and
+  // curvature are the robust stage's own, so the final solve would only
+  // confirm it with one more step.
+  const bool same = options.robust && same_linearization(built, lm, *built.reading_loss, final_loss, catenary);
   *built.reading_loss = final_loss;
-  lm.set_max_iterations(std::max(options.max_iterations - iterations, 0));
-  result.solver = lm.solve();
-  if (iterations > 0) result.solver.initial_cost = robust_summary.initial_cost;
-  result.solver.iterations += iterations;
-  result.solver.successful_steps += robust_summary.successful_steps;
+  if (same && robust_summary.termination == TerminationType::kConverged) {
+    result.solver = robust_summary;
+  } else {
+    if (same) lm.reuse_last_linearization();
+    lm.set_max_iterations(std::max(options.max_iterations - iterations, 0));
+    result.solver = lm.solve();
+    if (iterations > 0) result.solver.initial_cost = robust_summary.initial_cost;
+    result.solver.iterations += iterations;
+    result.solver.successful_steps += robust_summary.successful_steps;
+  }
   result.message = result.solver.message;
   if (!result.solver.usable()) return result;
   std::vector<Key> globals;

@@ -116,6 +116,27 @@ TEST(RobustCalibration, CleanDataGivesTheLeastSquaresFitAndItsSigmas) {
   EXPECT_FALSE(robust.misfit) << robust.calibration.model_warning;
 }
 
+TEST(RobustCalibration, ARobustFitConvergedInsideTheWidthIsTheFinalFit) {
+  // GIVEN clean data, whose robust fit ends with every reading inside the
+  // Huber width, and the solves' starts counted (progress line 0)
+  const sim::SimulatedDataset data = simulate(large(35, 5));
+  auto solves = [&](CalibrationOptions options) {
+    int starts = 0;
+    options.progress = [&](const IterationSummary& s) { starts += s.iteration == 0; };
+    const CalibrationResult result = calibrate(data.nominal, data.samples, options);
+    EXPECT_TRUE(result.ok) << result.message;
+    return starts;
+  };
+  // WHEN calibrated with least squares as the final loss, and with a final
+  // Huber loss of 1 sigma, which clean readings exceed
+  CalibrationOptions narrow;
+  narrow.huber_width = 1.0;
+  // THEN the first takes the robust fit's minimum without a final solve,
+  // the second solves again
+  EXPECT_EQ(solves(CalibrationOptions{}), 1);
+  EXPECT_EQ(solves(narrow), 2);
+}
+
 TEST(RobustCalibration, TooManyGrossErrorsAreRefusedWithTheReason) {
   // GIVEN 20 % rows with gross encoder errors, and at most 10 % allowed
   sim::DatasetConfig config = large(35, 3);
