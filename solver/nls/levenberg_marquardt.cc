@@ -324,6 +324,15 @@ SolverSummary LevenbergMarquardt::Impl::solve() {
           cost = new_cost;
           ++summary.successful_steps;
           if (last_relative_decrease <= options.function_tolerance) stop = Stop::kFunction;
+        } else if (std::abs(cost - new_cost) <= options.function_tolerance * cost) {
+          // A refused candidate that changes the cost by no more than the
+          // tolerance: the cost is flat to within it here (at a minimum,
+          // its rounding decides the gain ratio), and shrinking the region
+          // would only try shorter steps of the same nothing. Ceres ends
+          // its solve on such a candidate too. NaN (not evaluable) fails
+          // the test.
+          last_relative_decrease = std::abs(cost - new_cost) / cost;
+          stop = Stop::kFunction;
         }
       }
     }

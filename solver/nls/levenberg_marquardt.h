@@ -18,7 +18,11 @@
 // (solver/nls/trust_region_strategy.h: accepted when the actual/predicted
 // cost reduction exceeds 1e-3). A damped matrix that is not positive
 // definite counts as a refused step. The candidate is evaluated on a copy of
-// the state, so a rejected step costs no undo.
+// the state, so a rejected step costs no undo. The solve has converged when
+// a candidate, accepted or refused, changes the cost by no more than
+// function_tolerance relative (as in Ceres), when a step is shorter than
+// parameter_tolerance relative, or when the gradient is within
+// gradient_tolerance.
 
 #include <functional>
 #include <memory>

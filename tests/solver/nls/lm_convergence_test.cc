@@ -6,6 +6,7 @@
 
 #include "lm_test_factors.h"
 #include "solver/nls/levenberg_marquardt.h"
+#include "solver/nls/sized_factor.h"
 
 namespace cdpr {
 namespace {
@@ -98,6 +99,38 @@ TEST(LevenbergMarquardt, RejectsStepsIntoTheNonEvaluableRegionAndStillConverges)
   EXPECT_GE(rejected, refusals);
   EXPECT_EQ(summary.termination, TerminationType::kConverged) << summary.message;
   EXPECT_NEAR(problem.vector(EffectKey(0))(0), 0.001, 1e-9);
+}
+
+// r = 1 + 1e-12 x, its Jacobian given as 1: a cost flat to within the
+// function tolerance where its linearisation promises a large gain, as at
+// a minimum whose rounding decides the gain ratio.
+class FlatFactor final : public SizedFactor<1, 1> {
+ public:
+  explicit FlatFactor(Key key) : SizedFactor({key}, Loss{}) {}
+
+ private:
+  bool evaluate_whitened(const double* const* x, double* r, double* const* j) const override {
+    r[0] = 1.0 + 1e-12 * x[0][0];
+    if (auto J = jacobian<0>(j)) (*J)(0, 0) = 1.0;
+    return true;
+  }
+};
+
+TEST(LevenbergMarquardt, ARefusedStepThatChangesTheCostWithinTheToleranceEndsTheSolve) {
+  // GIVEN a cost that the first step changes by 1e-12 relative, far less
+  // than its linearisation predicts
+  Problem problem;
+  problem.add_vector(EffectKey(0), Eigen::VectorXd::Zero(1));
+  problem.add_factor(std::make_unique<FlatFactor>(EffectKey(0)));
+  // WHEN solved
+  const SolverSummary summary = LevenbergMarquardt(problem, {}).solve();
+  // THEN that refused step ends it, converged on the function tolerance,
+  // where the trust region would otherwise shrink for 13 more iterations
+  EXPECT_EQ(summary.termination, TerminationType::kConverged) << summary.message;
+  EXPECT_EQ(summary.iterations, 1);
+  EXPECT_EQ(summary.successful_steps, 0);
+  EXPECT_NE(summary.message.find("function tolerance"), std::string::npos) << summary.message;
+  EXPECT_EQ(problem.vector(EffectKey(0))(0), 0.0);
 }
 
 // Line y = 2 t - 1 sampled with small alternating noise and one gross outlier.
