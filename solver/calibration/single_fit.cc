@@ -21,7 +21,11 @@ using Anchors = std::array<Eigen::Vector3d, kCableCount>;
 void fill_fit_rms(const Robot& robot, const std::vector<Sample>& samples, const Problem& problem,
                   const CalibrationOptions& options, FitSummary& fit) {
   Anchors anchors;
-  for (int i = 0; i < kCableCount; ++i) anchors[i] = problem.vector(AnchorKey(i));
+  std::array<double, kCableCount> offsets;
+  for (int i = 0; i < kCableCount; ++i) {
+    anchors[i] = problem.vector(AnchorKey(i));
+    offsets[i] = problem.vector(OffsetKey(i))(0);
+  }
   double sum_encoder = 0.0, sum_force = 0.0;
   int n_encoder = 0, n_force = 0;
   for (std::size_t k = 0; k < samples.size(); ++k) {
@@ -48,7 +52,7 @@ void fill_fit_rms(const Robot& robot, const std::vector<Sample>& samples, const 
       if (!cables) continue;
       for (int i = 0; i < kCableCount; ++i) {
         if (samples[k].encoder_left_out[i]) continue;
-        const double r = (*cables)[i].arc_length_m + problem.vector(OffsetKey(i))(0) - samples[k].encoder_m[i];
+        const double r = (*cables)[i].arc_length_m + offsets[i] - samples[k].encoder_m[i];
         sum_encoder += r * r;
         ++n_encoder;
       }
@@ -60,7 +64,7 @@ void fill_fit_rms(const Robot& robot, const std::vector<Sample>& samples, const 
     } else {
       for (int i = 0; i < kCableCount; ++i) {
         const Eigen::Vector3d b = pose.transform(robot.winches[i].attachment_platform);
-        const double r = (b - anchors[i]).norm() + problem.vector(OffsetKey(i))(0) - samples[k].encoder_m[i];
+        const double r = (b - anchors[i]).norm() + offsets[i] - samples[k].encoder_m[i];
         sum_encoder += r * r;
         ++n_encoder;
       }
