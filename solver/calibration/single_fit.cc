@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numeric>
+#include <optional>
 #include <span>
 
 #include "solver/model/cable_prediction.h"
@@ -165,6 +167,33 @@ std::vector<SensorReading> left_out_residuals(const Robot& robot, const BuiltPro
     }
   }
   return out;
+}
+
+// Reading factor `factor`'s part of `lm`'s last linearisation (its pose
+// prior precedes it); empty when a block is missing (a variable held
+// constant, or a linearisation not made).
+std::optional<FittedRowLinearization> row_linearization(const LevenbergMarquardt& lm, int factor) {
+  using Row = FittedRowLinearization;
+  Row row;
+  auto take = [](std::span<const double> from, double* to, std::size_t size) {
+    if (from.size() != size) return false;
+    std::copy(from.begin(), from.end(), to);
+    return true;
+  };
+  if (!take(lm.last_residuals(factor), row.residual.data(), row.residual.size()) ||
+      !take(lm.last_residuals(factor - 1), row.prior_residual.data(), row.prior_residual.size()) ||
+      !take(lm.last_jacobian(factor - 1, 0), row.prior_jacobian.data(), row.prior_jacobian.size())) {
+    return std::nullopt;
+  }
+  constexpr std::array<int, EffectPoseFactor::kBaseKeyCount> kBlockDims = {6, 2, 3, 3, 3, 3, 1, 1, 1, 1};
+  static_assert(std::accumulate(kBlockDims.begin(), kBlockDims.end(), 0) == Row::kColumns);
+  double* block = row.jacobian.data();
+  for (int key = 0; key < EffectPoseFactor::kBaseKeyCount; ++key) {
+    const std::size_t size = static_cast<std::size_t>(Row::kRows) * kBlockDims[key];
+    if (!take(lm.last_jacobian(factor, key), block, size)) return std::nullopt;
+    block += size;
+  }
+  return row;
 }
 
 // Residual rows (less the readings left out) less free tangent columns.
@@ -369,7 +398,8 @@ CalibrationResult calibrate_once(const Robot& robot, const std::vector<Sample>& 
                                     largest_studentised_residual(samples[k], lm.last_residuals(factor),
                                                                  lm.last_jacobian(factor, 0),
                                                                  lm.last_jacobian(factor, 1),
-                                                                 lm.last_jacobian(factor - 1, 0))});
+                                                                 lm.last_jacobian(factor - 1, 0)),
+                                    options.effects.empty() ? row_linearization(lm, factor) : std::nullopt});
     }
   }
   result.chi_square = 2.0 * result.solver.final_cost;
