@@ -77,7 +77,8 @@ Extension extension_of(const CalibrationOptions& options) {
 // The reduced normal equations over the global variables (fitted and added)
 // at the fit: S = sum over poses of C_k - B_k' A_k^-1 B_k and
 // b = sum of b_g,k - B_k' A_k^-1 b_l,k, with each pose's own unknowns
-// eliminated; `own` is diag(J_g' J_g) before elimination.
+// eliminated; `own` is diag(J_g' J_g) before elimination over the added
+// globals (0 over the fitted ones, which are not tested).
 struct ReducedSystem {
   Eigen::MatrixXd matrix;
   Eigen::VectorXd gradient;
@@ -208,7 +209,7 @@ bool reduce(const Robot& robot, const CalibrationOptions& options, const Calibra
     add_transposed_times_vector(kFactorRows, g, global.data(), g, residual.data(), 1.0, out.gradient.data());
     add_transposed_times_vector(kLocalDim, g, eliminated.data(), g, local_gradient.data(), -1.0, out.gradient.data());
     for (int r = 0; r < kFactorRows; ++r) {
-      for (int c = 0; c < g; ++c) own[c] += global[r * g + c] * global[r * g + c];
+      for (int c = x.fitted_dim; c < g; ++c) own[c] += global[r * g + c] * global[r * g + c];
     }
   }
   out.matrix = Eigen::Map<const Eigen::MatrixXd>(reduced.data(), g, g).selfadjointView<Eigen::Upper>();
