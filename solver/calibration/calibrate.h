@@ -4,9 +4,11 @@
 // extract anchors and offsets with their 1-sigma from the covariance.
 // Pure numerics: no I/O, no clock; progress is reported through a callback.
 
+#include <array>
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -89,6 +91,21 @@ struct TermTest {
 
 // One pose of the final fit as it ended: the row as fitted (gross errors
 // masked), its platform pose and the reference cable's force (f_h, f_v).
+// A row's part of a fit's last linearisation (whitened, after the loss:
+// LevenbergMarquardt::last_residuals, last_jacobian): its reading factor's
+// residuals and Jacobian blocks of the pose, reference force, anchors and
+// offsets (keys() order, each row-major, one after another), its pose
+// prior's residuals and pose block.
+struct FittedRowLinearization {
+  static constexpr int kRows = 2 * kCableCount + 1;
+  static constexpr int kColumns = 6 + 2 + 4 * kCableCount;
+  static constexpr int kPriorRows = 6;
+  std::array<double, kRows> residual{};
+  std::array<double, kRows * kColumns> jacobian{};
+  std::array<double, kPriorRows> prior_residual{};
+  std::array<double, kPriorRows * 6> prior_jacobian{};
+};
+
 struct FittedRow {
   Sample sample;
   Pose world_T_platform;
@@ -97,6 +114,10 @@ struct FittedRow {
   // solver's own last linearisation (largest_studentised_residual,
   // solver/calibration/row_attribution.h); infinity when not known.
   double largest_studentised = std::numeric_limits<double>::infinity();
+  // Kept by a fit of the base catenary model (no model terms), for the
+  // score test of missing terms (solver/calibration/term_tests.h); empty
+  // otherwise.
+  std::optional<FittedRowLinearization> linearization;
 };
 
 // Why a fit is flagged (CalibrationResult::misfit), the first that applies.

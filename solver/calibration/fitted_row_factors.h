@@ -2,8 +2,9 @@
 // A final fit's row evaluated where the fit ended: its pose prior and its
 // reading factor (EffectPoseFactor) at the row's fitted pose and reference
 // force, every global at the fit. The tests run after a fit that look at
-// one row at a time (the score test of missing terms, the studentised test
-// of the kept readings) linearise the rows this way.
+// one row at a time (the score test of missing terms where the fit kept no
+// linearisation of its own, the studentised test of the kept readings)
+// linearise the rows this way.
 
 #include <vector>
 

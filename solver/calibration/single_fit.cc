@@ -1,7 +1,11 @@
 #include "solver/calibration/single_fit.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <numeric>
+#include <optional>
+#include <span>
 
 #include "solver/model/cable_prediction.h"
 #include "solver/calibration/effect_pose_factor.h"
@@ -19,7 +23,11 @@ using Anchors = std::array<Eigen::Vector3d, kCableCount>;
 void fill_fit_rms(const Robot& robot, const std::vector<Sample>& samples, const Problem& problem,
                   const CalibrationOptions& options, FitSummary& fit) {
   Anchors anchors;
-  for (int i = 0; i < kCableCount; ++i) anchors[i] = problem.vector(AnchorKey(i));
+  std::array<double, kCableCount> offsets;
+  for (int i = 0; i < kCableCount; ++i) {
+    anchors[i] = problem.vector(AnchorKey(i));
+    offsets[i] = problem.vector(OffsetKey(i))(0);
+  }
   double sum_encoder = 0.0, sum_force = 0.0;
   int n_encoder = 0, n_force = 0;
   for (std::size_t k = 0; k < samples.size(); ++k) {
@@ -46,7 +54,7 @@ void fill_fit_rms(const Robot& robot, const std::vector<Sample>& samples, const 
       if (!cables) continue;
       for (int i = 0; i < kCableCount; ++i) {
         if (samples[k].encoder_left_out[i]) continue;
-        const double r = (*cables)[i].arc_length_m + problem.vector(OffsetKey(i))(0) - samples[k].encoder_m[i];
+        const double r = (*cables)[i].arc_length_m + offsets[i] - samples[k].encoder_m[i];
         sum_encoder += r * r;
         ++n_encoder;
       }
@@ -58,7 +66,7 @@ void fill_fit_rms(const Robot& robot, const std::vector<Sample>& samples, const 
     } else {
       for (int i = 0; i < kCableCount; ++i) {
         const Eigen::Vector3d b = pose.transform(robot.winches[i].attachment_platform);
-        const double r = (b - anchors[i]).norm() + problem.vector(OffsetKey(i))(0) - samples[k].encoder_m[i];
+        const double r = (b - anchors[i]).norm() + offsets[i] - samples[k].encoder_m[i];
         sum_encoder += r * r;
         ++n_encoder;
       }
@@ -68,23 +76,50 @@ void fill_fit_rms(const Robot& robot, const std::vector<Sample>& samples, const 
   fit.rms_force_n = n_force ? std::sqrt(sum_force / n_force) : 0.0;
 }
 
-// The whitened residual of every reading at the problem's current values.
-std::vector<ReadingResidual> reading_residuals(const BuiltProblem& built, const CalibrationOptions& options,
-                                               int reference_cable) {
+// Whether a residual stored after `loss` is the residual itself: the loss
+// left its row as least squares would. A Huber residual just beyond the
+// width is scaled to just above it, give or take rounding, so those within
+// a hair of the width do not count as inside it.
+bool unscaled_by(const LossFunction& loss, double stored) {
+  constexpr double kWidthMargin = 1.0 - 1e-9;
+  return loss.kind == LossKind::kHuber && loss.width > 0.0 ? std::abs(stored) <= kWidthMargin * loss.width
+                                                           : loss.quadratic_at(stored);
+}
+
+// The whitened residual of every reading at the problem's current values,
+// where `lm`'s last solve ended with the readings' loss as it is now. A
+// factor whose reading rows that loss left as least squares would is read
+// from that solve's last linearisation (the same bits: a factor's
+// residuals do not depend on whether its Jacobian is wanted); any other is
+// evaluated again without the loss.
+std::vector<ReadingResidual> reading_residuals(const BuiltProblem& built, const LevenbergMarquardt& lm,
+                                               const CalibrationOptions& options, int reference_cable) {
   const LossFunction kept = *built.reading_loss;
   *built.reading_loss = LossFunction{};
   std::vector<ReadingResidual> out;
-  std::vector<double> residual;
+  std::vector<double> evaluated;
   const auto& factors = built.problem->factors();
+  // The factor's residuals without the loss, or an empty span when it cannot be evaluated.
+  auto residuals = [&](int f, std::span<const int> reading_rows) -> std::span<const double> {
+    const std::span<const double> stored = lm.last_residuals(f);
+    const bool reusable = stored.size() == static_cast<std::size_t>(factors[f]->residual_dim()) &&
+                          std::all_of(reading_rows.begin(), reading_rows.end(),
+                                      [&](int row) { return unscaled_by(kept, stored[row]); });
+    if (reusable) return stored;
+    evaluated.assign(factors[f]->residual_dim(), 0.0);
+    double cost = 0.0;
+    if (!factors[f]->evaluate(parameter_blocks(*built.problem, *factors[f]).data(), evaluated.data(), nullptr,
+                              &cost)) {
+      return {};
+    }
+    return evaluated;
+  };
+  constexpr std::array<int, 1> kRigidRows = {0};
   for (std::size_t k = 0; k < built.samples.size(); ++k) {
     const int id = built.samples[k].id;
-    auto evaluate = [&](const Factor& factor) {
-      residual.assign(factor.residual_dim(), 0.0);
-      double cost = 0.0;
-      return factor.evaluate(parameter_blocks(*built.problem, factor).data(), residual.data(), nullptr, &cost);
-    };
     if (options.cable_model == CableModelKind::kCatenary) {
-      if (!evaluate(*factors[built.reading_factor[k]])) continue;
+      const std::span<const double> residual = residuals(built.reading_factor[k], kReadingRows);
+      if (residual.empty()) continue;
       const Sample& sample = built.samples[k];
       for (int i = 0; i < kCableCount; ++i) {
         if (!sample.encoder_left_out[i]) out.push_back({id, SensorKind::kEncoder, i, residual[encoder_row(i)]});
@@ -92,7 +127,8 @@ std::vector<ReadingResidual> reading_residuals(const BuiltProblem& built, const 
       if (!sample.force_left_out) out.push_back({id, SensorKind::kForce, reference_cable, residual[kForceRow]});
     } else {
       for (int i = 0; i < kCableCount; ++i) {
-        if (evaluate(*factors[built.reading_factor[k] + i])) out.push_back({id, SensorKind::kEncoder, i, residual[0]});
+        const std::span<const double> residual = residuals(built.reading_factor[k] + i, kRigidRows);
+        if (!residual.empty()) out.push_back({id, SensorKind::kEncoder, i, residual[0]});
       }
     }
   }
@@ -104,14 +140,14 @@ std::vector<ReadingResidual> reading_residuals(const BuiltProblem& built, const 
 // factor evaluated again without its mask, normalised by the spread of the
 // readings that were fitted.
 std::vector<SensorReading> left_out_residuals(const Robot& robot, const BuiltProblem& built,
-                                              const CalibrationOptions& options) {
+                                              const LevenbergMarquardt& lm, const CalibrationOptions& options) {
   std::vector<SensorReading> out;
   // Clean data leave nothing out: no spreads to evaluate every factor for.
   if (std::none_of(built.samples.begin(), built.samples.end(),
                    [](const Sample& s) { return left_out_rows(s).count > 0; })) {
     return out;
   }
-  const ReadingSpreads spreads = reading_spreads(reading_residuals(built, options, robot.reference_cable));
+  const ReadingSpreads spreads = reading_spreads(reading_residuals(built, lm, options, robot.reference_cable));
   for (std::size_t k = 0; k < built.samples.size(); ++k) {
     const Sample& sample = built.samples[k];
     if (left_out_rows(sample).count == 0) continue;
@@ -133,6 +169,33 @@ std::vector<SensorReading> left_out_residuals(const Robot& robot, const BuiltPro
   return out;
 }
 
+// Reading factor `factor`'s part of `lm`'s last linearisation (its pose
+// prior precedes it); empty when a block is missing (a variable held
+// constant, or a linearisation not made).
+std::optional<FittedRowLinearization> row_linearization(const LevenbergMarquardt& lm, int factor) {
+  using Row = FittedRowLinearization;
+  Row row;
+  auto take = [](std::span<const double> from, double* to, std::size_t size) {
+    if (from.size() != size) return false;
+    std::copy(from.begin(), from.end(), to);
+    return true;
+  };
+  if (!take(lm.last_residuals(factor), row.residual.data(), row.residual.size()) ||
+      !take(lm.last_residuals(factor - 1), row.prior_residual.data(), row.prior_residual.size()) ||
+      !take(lm.last_jacobian(factor - 1, 0), row.prior_jacobian.data(), row.prior_jacobian.size())) {
+    return std::nullopt;
+  }
+  constexpr std::array<int, EffectPoseFactor::kBaseKeyCount> kBlockDims = {6, 2, 3, 3, 3, 3, 1, 1, 1, 1};
+  static_assert(std::accumulate(kBlockDims.begin(), kBlockDims.end(), 0) == Row::kColumns);
+  double* block = row.jacobian.data();
+  for (int key = 0; key < EffectPoseFactor::kBaseKeyCount; ++key) {
+    const std::size_t size = static_cast<std::size_t>(Row::kRows) * kBlockDims[key];
+    if (!take(lm.last_jacobian(factor, key), block, size)) return std::nullopt;
+    block += size;
+  }
+  return row;
+}
+
 // Residual rows (less the readings left out) less free tangent columns.
 int degrees_of_freedom(const Problem& problem, const std::vector<Sample>& samples) {
   int rows = 0, columns = 0;
@@ -145,20 +208,13 @@ int degrees_of_freedom(const Problem& problem, const std::vector<Sample>& sample
 // Whether the linearisation the last solve ended with is, bit for bit, what
 // the factors give with `next` as the readings' loss instead of `current`:
 // both leave every reading row as least squares would (no other row sees
-// the readings' loss). The stored residuals are after `current`'s scaling;
-// a Huber residual just beyond the width is scaled to just above it, give
-// or take rounding, so those within a hair of the width do not count as
-// inside it.
+// the readings' loss). The stored residuals are after `current`'s scaling.
 bool same_linearization(const BuiltProblem& built, const LevenbergMarquardt& lm, const LossFunction& current,
                         const LossFunction& next, bool catenary) {
-  constexpr double kWidthMargin = 1.0 - 1e-9;
   auto quadratic = [&](int factor, int row) {
     const std::span<const double> r = lm.last_residuals(factor);
     if (static_cast<std::size_t>(row) >= r.size()) return false;
-    const bool unscaled = current.kind == LossKind::kHuber && current.width > 0.0
-                              ? std::abs(r[row]) <= kWidthMargin * current.width
-                              : current.quadratic_at(r[row]);
-    return unscaled && next.quadratic_at(r[row]);
+    return unscaled_by(current, r[row]) && next.quadratic_at(r[row]);
   };
   for (std::size_t k = 0; k < built.samples.size(); ++k) {
     const int first = built.reading_factor[k];
@@ -198,10 +254,10 @@ std::vector<SensorReading> robust_stages(BuiltProblem& built, LevenbergMarquardt
     return s.usable();
   };
   if (!stage({LossKind::kHuber, kHuberWidth})) return {};
-  const double largest = largest_normalised_residual(reading_residuals(built, options, reference_cable));
+  const double largest = largest_normalised_residual(reading_residuals(built, lm, options, reference_cable));
   if (largest <= options.rejection_threshold_sigma) return {};
   if (!stage({LossKind::kCauchy, kCauchyWidth})) return {};
-  const std::vector<ReadingResidual> residuals = reading_residuals(built, options, reference_cable);
+  const std::vector<ReadingResidual> residuals = reading_residuals(built, lm, options, reference_cable);
   const std::vector<SensorReading> flagged = gross_errors(residuals, options.rejection_threshold_sigma);
   if (flagged.empty()) return {};
   // Leave-one-out names the reading of each flagged row (solver/calibration/row_attribution.h).
@@ -339,7 +395,7 @@ CalibrationResult calibrate_once(const Robot& robot, const std::vector<Sample>& 
   cal.fit.iterations = result.solver.iterations;
   fill_fit_rms(robot, samples, problem, options, cal.fit);
   if (catenary) {
-    result.left_out_residuals = left_out_residuals(robot, built, options);
+    result.left_out_residuals = left_out_residuals(robot, built, lm, options);
     result.fitted_rows.reserve(samples.size());
     for (std::size_t k = 0; k < samples.size(); ++k) {
       const int pose = static_cast<int>(k);
@@ -348,7 +404,8 @@ CalibrationResult calibrate_once(const Robot& robot, const std::vector<Sample>& 
                                     largest_studentised_residual(samples[k], lm.last_residuals(factor),
                                                                  lm.last_jacobian(factor, 0),
                                                                  lm.last_jacobian(factor, 1),
-                                                                 lm.last_jacobian(factor - 1, 0))});
+                                                                 lm.last_jacobian(factor - 1, 0)),
+                                    options.effects.empty() ? row_linearization(lm, factor) : std::nullopt});
     }
   }
   result.chi_square = 2.0 * result.solver.final_cost;

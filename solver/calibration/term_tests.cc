@@ -10,6 +10,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
+#include "solver/calibration/absent_term_columns.h"
 #include "solver/calibration/chi_square.h"
 #include "solver/calibration/effect_pose_factor.h"
 #include "solver/calibration/fitted_row_factors.h"
@@ -76,7 +77,8 @@ Extension extension_of(const CalibrationOptions& options) {
 // The reduced normal equations over the global variables (fitted and added)
 // at the fit: S = sum over poses of C_k - B_k' A_k^-1 B_k and
 // b = sum of b_g,k - B_k' A_k^-1 b_l,k, with each pose's own unknowns
-// eliminated; `own` is diag(J_g' J_g) before elimination.
+// eliminated; `own` is diag(J_g' J_g) before elimination over the added
+// globals (0 over the fitted ones, which are not tested).
 struct ReducedSystem {
   Eigen::MatrixXd matrix;
   Eigen::VectorXd gradient;
@@ -142,13 +144,37 @@ bool reduce(const Robot& robot, const CalibrationOptions& options, const Calibra
   std::array<double, kFactorRows> residual;
   std::array<double, kPriorRows> prior_residual;
   out.gradient = Eigen::VectorXd::Zero(g);
+  // A base catenary fit kept its last linearisation of each row: only the
+  // added terms' columns are new (absent_term_columns.h). Otherwise the
+  // extended factor is evaluated at the fit.
+  const bool from_fit =
+      options.effects.empty() && std::all_of(result.fitted_rows.begin(), result.fitted_rows.end(),
+                                             [](const FittedRow& row) { return row.linearization.has_value(); });
+  std::array<Eigen::Vector3d, kCableCount> anchor_world;
+  for (int i = 0; i < kCableCount; ++i) anchor_world[i] = result.calibration.winches[i].anchor_world;
+  auto linearise = [&](int k) {
+    const FittedRow& row = result.fitted_rows[k];
+    if (!from_fit) {
+      return evaluate_fitted_row(robot, row, k, options.height_sigma_m, loss, x.effects, pose.data(), force.data(),
+                                 parameters.data(),
+                                 {prior_residual.data(), prior_jacobians, residual.data(), jacobians.data()});
+    }
+    const FittedRowLinearization& fit = *row.linearization;
+    std::copy(fit.residual.begin(), fit.residual.end(), residual.begin());
+    std::copy(fit.prior_residual.begin(), fit.prior_residual.end(), prior_residual.begin());
+    std::copy(fit.prior_jacobian.begin(), fit.prior_jacobian.end(), prior_jacobian.begin());
+    const double* block = fit.jacobian.data();
+    for (int b = 0; b < EffectPoseFactor::kBaseKeyCount; ++b) {
+      std::copy_n(block, blocks[b].size(), blocks[b].begin());
+      block += blocks[b].size();
+    }
+    return absent_term_jacobians(
+        robot, {row.sample, row.world_T_platform, row.reference_force, anchor_world, offsets}, options.height_sigma_m,
+        loss, x.effects, jacobians.data() + EffectPoseFactor::kBaseKeyCount);
+  };
   const int n = static_cast<int>(result.fitted_rows.size());
   for (int k = 0; k < n; ++k) {
-    if (!evaluate_fitted_row(robot, result.fitted_rows[k], k, options.height_sigma_m, loss, x.effects, pose.data(),
-                             force.data(), parameters.data(),
-                             {prior_residual.data(), prior_jacobians, residual.data(), jacobians.data()})) {
-      return false;
-    }
+    if (!linearise(k)) return false;
     for (std::size_t b = 0; b < blocks.size(); ++b) {
       const int d = block_dims[b];
       const int column = b == 0 ? 0 : b == 1 ? 6 : block_column[b];
@@ -183,7 +209,7 @@ bool reduce(const Robot& robot, const CalibrationOptions& options, const Calibra
     add_transposed_times_vector(kFactorRows, g, global.data(), g, residual.data(), 1.0, out.gradient.data());
     add_transposed_times_vector(kLocalDim, g, eliminated.data(), g, local_gradient.data(), -1.0, out.gradient.data());
     for (int r = 0; r < kFactorRows; ++r) {
-      for (int c = 0; c < g; ++c) own[c] += global[r * g + c] * global[r * g + c];
+      for (int c = x.fitted_dim; c < g; ++c) own[c] += global[r * g + c] * global[r * g + c];
     }
   }
   out.matrix = Eigen::Map<const Eigen::MatrixXd>(reduced.data(), g, g).selfadjointView<Eigen::Upper>();

@@ -278,11 +278,12 @@ void SchurComplement::accumulate_gathered(int slot, int f, double* gradient) {
     add_transposed_times_vector(depth(run.rows), run.width, j + run.rows.first * width + run.column, width,
                                 residual + run.rows.first, 1.0, g + run.column);
   }
-  for (int c = 0; c < gc; ++c) gradient[local_dim_ + plan.global_begin + c] += g[lc + c];
-  if (lc > 0) {
-    const int first = groups_[plan.group].column + plan.local_begin;
-    for (int c = 0; c < lc; ++c) gradient[first + c] += g[c];
-  }
+  // As Eigen maps: an element loop, which may not assume that the two
+  // buffers are apart, adds one double at a time.
+  using Segment = Eigen::Map<Eigen::VectorXd>;
+  using ConstSegment = Eigen::Map<const Eigen::VectorXd>;
+  Segment(gradient + local_dim_ + plan.global_begin, gc) += ConstSegment(g + lc, gc);
+  if (lc > 0) Segment(gradient + groups_[plan.group].column + plan.local_begin, lc) += ConstSegment(g, lc);
   double* targets[3] = {a_.data(), b_.data(), c_.data()};
   for (int p = plan.product_begin; p < plan.product_end; ++p) {
     const RunProduct& product = products_[p];
