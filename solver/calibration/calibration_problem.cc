@@ -144,6 +144,10 @@ BuiltProblem build_calibration_problem(const Robot& robot, const std::vector<Sam
   std::vector<Eigen::Vector2d> forces;
   std::vector<Pose> start_poses;
   std::vector<std::array<double, kCableCount>> lengths;
+  samples.reserve(all_samples.size());
+  forces.reserve(all_samples.size());
+  start_poses.reserve(all_samples.size());
+  lengths.reserve(all_samples.size());
   for (const Sample& sample : all_samples) {
     if (catenary) {
       const PoseStart start = start_pose(robot, nominal, sample, options);
@@ -167,6 +171,7 @@ BuiltProblem build_calibration_problem(const Robot& robot, const std::vector<Sam
   }
   const std::array<double, kCableCount> offsets = mean_offsets(samples, lengths);
 
+  built.reading_factor.reserve(samples.size());
   built.problem = std::make_unique<Problem>();
   Problem& problem = *built.problem;
   for (int i = 0; i < kCableCount; ++i) {
