@@ -84,21 +84,20 @@ PoseStart start_pose(const Robot& robot, const Anchors& anchors, const Sample& s
   };
   for (int step = 0; step <= 2 * kYawSteps; ++step) {
     const double yaw = kYawStepRad * ((step + 1) / 2) * (step % 2 ? 1.0 : -1.0);
-    Sample turned = sample;
-    turned.world_R_platform = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())) * sample.world_R_platform;
+    const Sample turned = turned_about_vertical(sample, yaw);
+    // The statics at this heading, factorised once for both guesses and
+    // the polish's start.
+    const std::optional<ReferenceForceMap> map = sample_force_map(robot, anchors, turned);
+    if (!map) continue;
     for (int guess = 0; guess < 2; ++guess) {
       const Eigen::Vector2d initial = guess == 0 ? paper_reference_force_guess(robot, anchors, turned)
                                                  : rigid_reference_force_guess(robot, anchors, turned);
-      const std::optional<Eigen::Vector2d> force =
-          refine_reference_force(robot, anchors, turned, initial, o.height_sigma_m);
+      const std::optional<Eigen::Vector2d> force = refine_reference_force(robot, *map, turned, initial, o.height_sigma_m);
       if (!force || !(force->norm() <= max_tension)) continue;
       const std::optional<ForceAndHeading> polished = refine_reference_force_and_heading(
-          robot, anchors, sample, *force, yaw, yaw - kPolishRad, yaw + kPolishRad, o.height_sigma_m);
+          robot, anchors, sample, *force, yaw, yaw - kPolishRad, yaw + kPolishRad, o.height_sigma_m, *map);
       if (polished && polished->reference_force.norm() <= max_tension) {
-        Sample polished_turn = sample;
-        polished_turn.world_R_platform =
-            Eigen::Quaterniond(Eigen::AngleAxisd(polished->yaw_rad, Eigen::Vector3d::UnitZ())) * sample.world_R_platform;
-        if (take(polished_turn, polished->reference_force)) return start;
+        if (take(turned_about_vertical(sample, polished->yaw_rad), polished->reference_force)) return start;
       }
       if (take(turned, *force)) return start;
     }
@@ -145,6 +144,10 @@ BuiltProblem build_calibration_problem(const Robot& robot, const std::vector<Sam
   std::vector<Eigen::Vector2d> forces;
   std::vector<Pose> start_poses;
   std::vector<std::array<double, kCableCount>> lengths;
+  samples.reserve(all_samples.size());
+  forces.reserve(all_samples.size());
+  start_poses.reserve(all_samples.size());
+  lengths.reserve(all_samples.size());
   for (const Sample& sample : all_samples) {
     if (catenary) {
       const PoseStart start = start_pose(robot, nominal, sample, options);
@@ -168,6 +171,7 @@ BuiltProblem build_calibration_problem(const Robot& robot, const std::vector<Sam
   }
   const std::array<double, kCableCount> offsets = mean_offsets(samples, lengths);
 
+  built.reading_factor.reserve(samples.size());
   built.problem = std::make_unique<Problem>();
   Problem& problem = *built.problem;
   for (int i = 0; i < kCableCount; ++i) {

@@ -10,6 +10,15 @@ BlockJacobian::BlockJacobian(std::vector<int> variable_dim, std::vector<bool> co
     : variable_dim_(std::move(variable_dim)), constant_(std::move(constant)),
       variable_column_(variable_dim_.size(), -1) {}
 
+void BlockJacobian::reserve(int factors, int keys) {
+  layout_.reserve(factors);
+  key_variable_.reserve(keys);
+  key_column_.reserve(keys);
+  key_dim_.reserve(keys);
+  key_rows_.reserve(keys);
+  key_jacobian_offset_.reserve(keys);
+}
+
 void BlockJacobian::add_factor(int residual_dim, std::span<const int> variables, std::span<const RowRange> rows) {
   FactorLayout f;
   f.residual_offset = residual_total_;

@@ -30,6 +30,9 @@ class BlockJacobian {
   // (no column, no Jacobian block).
   BlockJacobian(std::vector<int> variable_dim, std::vector<bool> constant);
 
+  // Room for `factors` factors reading `keys` variables in all, so that
+  // appending them does not regrow the per-factor and per-key arrays.
+  void reserve(int factors, int keys);
   // Appends a factor of `residual_dim` rows reading `variables`; rows[k]:
   // the rows in which variables[k]'s block can be nonzero.
   void add_factor(int residual_dim, std::span<const int> variables, std::span<const RowRange> rows);

@@ -141,8 +141,17 @@ SchurComplement::SchurComplement(const BlockJacobian& jacobian, const std::vecto
   const int n = global_dim_;
   auto global_column = [&](int v) { return column_of(v) - local_dim_; };
 
-  // The global variables each group's factors reach, and each factor's group.
-  std::vector<std::vector<int>> coupled_variables(group_count);
+  // Each factor's group, the global variables in column order, and which
+  // of them each group's factors reach (a groups x globals table).
+  std::vector<int> globals;
+  for (int v = 0; v < nv; ++v) {
+    if (group_of[v] < 0 && column_of(v) >= 0) globals.push_back(v);
+  }
+  std::sort(globals.begin(), globals.end(), [&](int x, int y) { return column_of(x) < column_of(y); });
+  const std::size_t global_count = globals.size();
+  std::vector<int> global_index(nv, -1);
+  for (std::size_t i = 0; i < global_count; ++i) global_index[globals[i]] = static_cast<int>(i);
+  std::vector<unsigned char> reaches(group_count * global_count, 0);
   std::vector<int>& factor_group = factor_group_;
   factor_group.assign(nf, -1);
   for (int f = 0; f < nf; ++f) {
@@ -153,18 +162,17 @@ SchurComplement::SchurComplement(const BlockJacobian& jacobian, const std::vecto
     const int g = factor_group[f];
     if (g < 0) continue;
     for (int k = 0; k < jacobian_.key_count(f); ++k) {
-      const int v = jacobian_.key_variable(f, k);
-      if (group_of[v] < 0 && column_of(v) >= 0) coupled_variables[g].push_back(v);
+      const int i = global_index[jacobian_.key_variable(f, k)];
+      if (i >= 0) reaches[g * global_count + i] = 1;
     }
   }
   int block_total = 0, coupling_total = 0;
   for (int g = 0; g < group_count; ++g) {
-    std::vector<int>& list = coupled_variables[g];
-    std::sort(list.begin(), list.end(), [&](int x, int y) { return column_of(x) < column_of(y); });
-    list.erase(std::unique(list.begin(), list.end()), list.end());
     Group& group = groups_[g];
     group.coupled_begin = static_cast<int>(coupled_.size());
-    for (int v : list) {
+    for (std::size_t i = 0; i < global_count; ++i) {
+      if (!reaches[g * global_count + i]) continue;
+      const int v = globals[i];
       for (int d = 0; d < jacobian_.variable_dim(v); ++d) coupled_.push_back(global_column(v) + d);
     }
     group.coupled_end = static_cast<int>(coupled_.size());

@@ -133,7 +133,9 @@ class SchurComplement {
   // a thousand poses allocates next to nothing.
   struct RunCache {
     std::vector<std::pair<std::vector<ColumnRun>, std::vector<ColumnRun>>> splits;
-    std::vector<bool> filled;            // per gathered column: a key fills it
+    // Per gathered column: 1 when a key fills it (bytes, not vector<bool>:
+    // cheaper to set and to test).
+    std::vector<unsigned char> filled;
     std::vector<RowRange> column_rows;   // per gathered column: its key's rows (none for a gap)
     std::vector<ColumnRun> initial;
   };

@@ -45,9 +45,9 @@ bool SchurComplement::plan_gathered(int f, int group, const std::vector<int>& gr
   plan.local_count = any_local ? local_end - plan.local_begin : 0;
   plan.global_count = any_global ? global_end - plan.global_begin : 0;
   const int width = plan.local_count + plan.global_count;
-  std::vector<bool>& filled = cache.filled;
+  std::vector<unsigned char>& filled = cache.filled;
   std::vector<RowRange>& column_rows = cache.column_rows;
-  filled.assign(width, false);
+  filled.assign(width, 0);
   column_rows.assign(width, RowRange{});
   for (int k = 0; k < lin.key_count(f); ++k) {
     const int v = lin.key_variable(f, k), column = lin.variable_column(v), d = lin.key_dim(f, k);
@@ -56,12 +56,12 @@ bool SchurComplement::plan_gathered(int f, int group, const std::vector<int>& gr
                                        : plan.local_count + column - local_dim_ - plan.global_begin;
     for (int c = first; c < first + d; ++c) {
       if (filled[c]) return false;  // a key listed twice
-      filled[c] = true;
+      filled[c] = 1;
       column_rows[c] = lin.key_rows(f, k);
     }
     gather_column_[lin.key_offset(f) + k] = first;
   }
-  plan.gaps = std::find(filled.begin(), filled.end(), false) != filled.end();
+  plan.gaps = std::find(filled.begin(), filled.end(), 0) != filled.end();
   plan.gathered = true;
   plans_[f] = plan;
   plan_runs(f, cache);

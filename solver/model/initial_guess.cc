@@ -1,7 +1,9 @@
 #include "solver/model/initial_guess.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "solver/model/catenary.h"
@@ -76,15 +78,59 @@ bool height_and_force(const Robot& robot, const ReferenceForceMap& map, const Sa
   return true;
 }
 
-std::optional<ReferenceForceMap> force_map(const Robot& robot, const std::array<Eigen::Vector3d, kCableCount>& anchors,
-                                           const Sample& sample) {
+bool fill_force_map(const Robot& robot, const std::array<Eigen::Vector3d, kCableCount>& anchors, const Sample& sample,
+                    ReferenceForceMap& map) {
   StaticsInput in;
   in.world_T_platform = Pose{sample.position_world, sample.world_R_platform};
   in.anchor_world = anchors;
-  ReferenceForceMap map;
-  if (reference_force_map(robot, in, map) != StaticsStatus::kOk) return std::nullopt;
-  return map;
+  return reference_force_map(robot, in, map) == StaticsStatus::kOk;
 }
+
+// The statics at the last two headings the heading fit evaluated. A trial
+// whose step stopped on a bound keeps the current heading, and one after a
+// refused step may return to it: both reuse its factorisation. Headings
+// match by their bits, so a reused map is the one the heading would give.
+class TurnedForceMaps {
+ public:
+  TurnedForceMaps(const Robot& robot, const std::array<Eigen::Vector3d, kCableCount>& anchors, const Sample& sample,
+                  double known_yaw_rad, const ReferenceForceMap& known)
+      : robot_(robot), anchors_(anchors), sample_(sample) {
+    Entry& entry = entries_[0];
+    entry.yaw_bits = std::bit_cast<std::uint64_t>(known_yaw_rad);
+    entry.filled = entry.defined = true;
+    entry.map = known;
+  }
+
+  // The statics at `sample` turned by `yaw_rad`; null where undefined.
+  const ReferenceForceMap* at(double yaw_rad) {
+    const std::uint64_t key = std::bit_cast<std::uint64_t>(yaw_rad);
+    int e = 0;
+    while (e < kEntries && !(entries_[e].filled && entries_[e].yaw_bits == key)) ++e;
+    if (e == kEntries) {
+      e = 1 - last_used_;  // the entry not used last
+      Entry& entry = entries_[e];
+      entry.yaw_bits = key;
+      entry.filled = true;
+      entry.defined = fill_force_map(robot_, anchors_, turned_about_vertical(sample_, yaw_rad), entry.map);
+    }
+    last_used_ = e;
+    return entries_[e].defined ? &entries_[e].map : nullptr;
+  }
+
+ private:
+  static constexpr int kEntries = 2;
+  struct Entry {
+    std::uint64_t yaw_bits = 0;
+    bool filled = false;
+    bool defined = false;
+    ReferenceForceMap map;
+  };
+  const Robot& robot_;
+  const std::array<Eigen::Vector3d, kCableCount>& anchors_;
+  const Sample& sample_;
+  std::array<Entry, kEntries> entries_;
+  int last_used_ = 0;
+};
 
 // Levenberg-Marquardt on the fit's residuals over N unknowns x, its steps
 // judged and its damping set by the solver's TrustRegionStrategy: a trial
@@ -142,17 +188,38 @@ bool damped_gauss_newton(Eigen::Matrix<double, N, 1>& x, const Evaluate& evaluat
 
 }  // namespace
 
+Sample turned_about_vertical(const Sample& sample, double yaw_rad) {
+  Sample turned = sample;
+  turned.world_R_platform =
+      Eigen::Quaterniond(Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ())) * sample.world_R_platform;
+  return turned;
+}
+
+std::optional<ReferenceForceMap> sample_force_map(const Robot& robot,
+                                                  const std::array<Eigen::Vector3d, kCableCount>& anchors,
+                                                  const Sample& sample) {
+  std::optional<ReferenceForceMap> map(std::in_place);
+  if (!fill_force_map(robot, anchors, sample, *map)) map.reset();
+  return map;
+}
+
 std::optional<Eigen::Vector2d> refine_reference_force(const Robot& robot,
                                                       const std::array<Eigen::Vector3d, kCableCount>& anchors,
+                                                      const Sample& sample, const Eigen::Vector2d& guess,
+                                                      double sigma_height_m) {
+  const std::optional<ReferenceForceMap> map = sample_force_map(robot, anchors, sample);
+  if (!map) return std::nullopt;
+  return refine_reference_force(robot, *map, sample, guess, sigma_height_m);
+}
+
+std::optional<Eigen::Vector2d> refine_reference_force(const Robot& robot, const ReferenceForceMap& map,
                                                       const Sample& sample, const Eigen::Vector2d& guess,
                                                       double sigma_height_m) {
   // Only the height and force rows constrain the force; encoder rows carry
   // the still unknown offsets. The pose and anchors are fixed, so the
   // statics are factorised once and each trial costs four catenaries.
-  const std::optional<ReferenceForceMap> map = force_map(robot, anchors, sample);
-  if (!map) return std::nullopt;
   auto evaluate = [&](const Eigen::Vector2d& force, FitResiduals& residual, FitJacobian& jacobian) {
-    return height_and_force(robot, *map, sample, force, sigma_height_m, residual, &jacobian);
+    return height_and_force(robot, map, sample, force, sigma_height_m, residual, &jacobian);
   };
   Eigen::Vector2d force = guess;
   const bool evaluable = damped_gauss_newton<2>(
@@ -166,7 +233,7 @@ std::optional<Eigen::Vector2d> refine_reference_force(const Robot& robot,
 std::optional<Eigen::Vector2d> search_feasible_reference_force(const Robot& robot,
                                                                const std::array<Eigen::Vector3d, kCableCount>& anchors,
                                                                const Sample& sample, double sigma_height_m) {
-  const std::optional<ReferenceForceMap> map = force_map(robot, anchors, sample);
+  const std::optional<ReferenceForceMap> map = sample_force_map(robot, anchors, sample);
   if (!map) return std::nullopt;
   FitResiduals residual;
   // A suspended platform's cables each carry at most a few times its weight.
@@ -190,16 +257,16 @@ std::optional<Eigen::Vector2d> search_feasible_reference_force(const Robot& robo
 
 std::optional<ForceAndHeading> refine_reference_force_and_heading(
     const Robot& robot, const std::array<Eigen::Vector3d, kCableCount>& anchors, const Sample& sample,
-    const Eigen::Vector2d& guess, double yaw_guess_rad, double yaw_min_rad, double yaw_max_rad, double sigma_height_m) {
+    const Eigen::Vector2d& guess, double yaw_guess_rad, double yaw_min_rad, double yaw_max_rad, double sigma_height_m,
+    const ReferenceForceMap& map_at_guess) {
   using Jacobian3 = Eigen::Matrix<double, kFitRows, 3>;
   const double weight_per_length = robot.gravity_mps2 * robot.cable_linear_density_kgpm;
   const double sigma_force = reading_sigmas(robot, sample).force_n;
+  TurnedForceMaps maps(robot, anchors, sample, yaw_guess_rad, map_at_guess);
   // Residuals and their Jacobian in (f_h, f_v, yaw) at one point: the
   // statics factorised at that heading, each catenary evaluated once.
   auto evaluate = [&](const Eigen::Vector2d& force, double yaw, FitResiduals& residual, Jacobian3& jacobian) {
-    Sample turned = sample;
-    turned.world_R_platform = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())) * sample.world_R_platform;
-    const std::optional<ReferenceForceMap> map = force_map(robot, anchors, turned);
+    const ReferenceForceMap* map = maps.at(yaw);
     if (!map) return false;
     std::array<Eigen::Vector2d, kCableCount> f;
     for (int i = 0; i < kCableCount; ++i) {

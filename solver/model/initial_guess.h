@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include "solver/model/platform_statics.h"
 #include "solver/model/robot.h"
 #include "solver/model/sample.h"
 
@@ -32,12 +33,28 @@ std::optional<Eigen::Vector2d> search_feasible_reference_force(const Robot& robo
                                                                const std::array<Eigen::Vector3d, kCableCount>& anchors,
                                                                const Sample& sample, double sigma_height_m);
 
+// `sample` with its pose turned by `yaw_rad` about the world vertical
+// through the platform origin (the start's heading search).
+Sample turned_about_vertical(const Sample& sample, double yaw_rad);
+
+// The statics at `sample`'s pose with the anchors held fixed, factorised
+// once for any reference force (ReferenceForceMap, platform_statics.h).
+// Empty where they are undefined (a vertical cable, a singular Eq. (11)).
+std::optional<ReferenceForceMap> sample_force_map(const Robot& robot,
+                                                  const std::array<Eigen::Vector3d, kCableCount>& anchors,
+                                                  const Sample& sample);
+
 // Refines (f_h, f_v) of the reference cable at one pose, anchors held fixed,
 // by damped Gauss-Newton on the height (Eq. 15) and force (Eq. 16)
 // residuals, starting from `guess`. Empty when the statics cannot be
 // evaluated near the guess (e.g. a cable would push).
 std::optional<Eigen::Vector2d> refine_reference_force(const Robot& robot,
                                                       const std::array<Eigen::Vector3d, kCableCount>& anchors,
+                                                      const Sample& sample, const Eigen::Vector2d& guess,
+                                                      double sigma_height_m);
+// The same from the pose's statics already factorised: `map` is
+// sample_force_map(robot, anchors, sample).
+std::optional<Eigen::Vector2d> refine_reference_force(const Robot& robot, const ReferenceForceMap& map,
                                                       const Sample& sample, const Eigen::Vector2d& guess,
                                                       double sigma_height_m);
 
@@ -47,13 +64,17 @@ std::optional<Eigen::Vector2d> refine_reference_force(const Robot& robot,
 // kept in [yaw_min_rad, yaw_max_rad], starting from `guess` at
 // `yaw_guess_rad`. Every accepted point is evaluable (all cables pull).
 // Empty when the statics cannot be evaluated at the start.
+// `map_at_guess`: the statics at the guess's heading, sample_force_map() of
+// turned_about_vertical(sample, yaw_guess_rad) (the caller has them from
+// refining the guess).
 struct ForceAndHeading {
   Eigen::Vector2d reference_force = Eigen::Vector2d::Zero();
   double yaw_rad = 0.0;
 };
 std::optional<ForceAndHeading> refine_reference_force_and_heading(
     const Robot& robot, const std::array<Eigen::Vector3d, kCableCount>& anchors, const Sample& sample,
-    const Eigen::Vector2d& guess, double yaw_guess_rad, double yaw_min_rad, double yaw_max_rad, double sigma_height_m);
+    const Eigen::Vector2d& guess, double yaw_guess_rad, double yaw_min_rad, double yaw_max_rad, double sigma_height_m,
+    const ReferenceForceMap& map_at_guess);
 
 // Encoder offsets as the mean of (reading - modelled length) over the
 // samples; `lengths[k][i]` is the modelled length of cable i at sample k.

@@ -177,6 +177,7 @@ struct LevenbergMarquardt::Impl {
     rhs.assign(n, 0.0);
     candidate.assign(p.state().size(), 0.0);
     linearized_state.assign(p.state().size(), 0.0);
+    column_of.reserve(p.variables().size());
     for (std::size_t v = 0; v < p.variables().size(); ++v) {
       column_of.push_back(system->variable_column(static_cast<int>(v)));
     }

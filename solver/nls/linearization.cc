@@ -21,6 +21,10 @@ BlockJacobian empty_jacobian(const Problem& problem) {
 
 Linearization::Linearization(const Problem& problem) : problem_(problem), jacobian_(empty_jacobian(problem)) {
   const auto& variables = problem.variables();
+  std::size_t key_count = 0;
+  for (const auto& factor : problem.factors()) key_count += factor->keys().size();
+  jacobian_.reserve(static_cast<int>(problem.factors().size()), static_cast<int>(key_count));
+  key_ambient_offset_.reserve(key_count);
   std::vector<int> key_variables;
   std::vector<RowRange> key_rows;
   for (const auto& factor : problem.factors()) {

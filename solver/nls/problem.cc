@@ -141,17 +141,18 @@ EliminationOrder Problem::elimination_order() const {
   const int nv = static_cast<int>(variables_.size());
   EliminationOrder order;
   order.group.assign(nv, EliminationOrder::kKept);
-  std::map<int, int> group_of_pose;
   for (int v = 0; v < nv; ++v) {
     const Variable& var = variables_[v];
     if (var.constant) continue;
-    if (var.key.kind != VariableKind::kPose && var.key.kind != VariableKind::kReferenceForce) {
+    const bool pose = var.key.kind == VariableKind::kPose;
+    if (!pose && var.key.kind != VariableKind::kReferenceForce) {
       order.kept.push_back(v);
       continue;
     }
-    const auto [it, inserted] = group_of_pose.emplace(var.key.index, order.group_count);
-    if (inserted) ++order.group_count;
-    order.group[v] = it->second;
+    // The pose's other variable opened its group if it came first.
+    const int other = find(pose ? ReferenceForceKey(var.key.index) : PoseKey(var.key.index));
+    const bool other_grouped = other >= 0 && order.group[other] != EliminationOrder::kKept;
+    order.group[v] = other_grouped ? order.group[other] : order.group_count++;
   }
   std::stable_sort(order.kept.begin(), order.kept.end(),
                    [&](int a, int b) { return variables_[a].key < variables_[b].key; });

@@ -68,6 +68,30 @@ TEST(Problem, FindsVariablesByKeyOfAnyIndex) {
   EXPECT_FALSE(problem.has(EffectKey(-3)));
 }
 
+TEST(Problem, GroupsEachPosesVariablesInOrderOfFirstAppearance) {
+  // GIVEN pose 5's force before its pose, pose 2 without a force, pose 9's
+  // pose before its force, a constant pose and globals in no key order
+  Problem problem;
+  problem.add_vector(OffsetKey(0), Eigen::VectorXd::Constant(1, 0.0));             // 0
+  problem.add_vector(ReferenceForceKey(5), Eigen::Vector2d(1, 1));                  // 1
+  problem.add_pose(PoseKey(2), Pose{});                                             // 2
+  problem.add_vector(AnchorKey(1), Eigen::Vector3d::Zero());                        // 3
+  problem.add_pose(PoseKey(9), Pose{});                                             // 4
+  problem.add_pose(PoseKey(5), Pose{});                                             // 5
+  problem.add_pose(PoseKey(7), Pose{});                                             // 6
+  problem.add_vector(ReferenceForceKey(9), Eigen::Vector2d(1, 1));                  // 7
+  problem.add_vector(AnchorKey(0), Eigen::Vector3d::Zero());                        // 8
+  problem.set_constant(PoseKey(7), true);
+  // WHEN ordered for elimination
+  const EliminationOrder order = problem.elimination_order();
+  // THEN a pose and its force share a group, numbered as first met; the
+  // constant pose takes no part; the globals are kept by key
+  constexpr int kKept = EliminationOrder::kKept;
+  EXPECT_EQ(order.group_count, 3);
+  EXPECT_EQ(order.group, (std::vector<int>{kKept, 0, 1, kKept, 2, 0, kKept, 2, kKept}));
+  EXPECT_EQ(order.kept, (std::vector<int>{8, 3, 0}));
+}
+
 TEST(ProblemDeathTest, RefusesFactorsOnUnknownVariables) {
   // GIVEN a factor naming a variable that was never added; THEN abort with its name
   Problem problem;
