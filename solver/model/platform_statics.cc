@@ -17,21 +17,19 @@ struct CableGeometry {
   double span = 0.0;
 };
 
-// Wrench columns of J^T for one cable, Eq. (8): f_h acts along -s_c, f_v along +z.
-// (Fixed-size segments, not Eigen's comma initializer: these run for every
-// statics evaluation, and the initializer's runtime bookkeeping cost more
-// than the arithmetic.)
-Wrench column_h(const CableGeometry& g) {
-  Wrench c;
-  c.head<3>() = -g.s_c;
-  c.tail<3>() = -g.lever_world.cross(g.s_c);
-  return c;
+// Wrench columns of J^T for one cable, Eq. (8): f_h acts along -s_c, f_v
+// along +z. Written in place (a column of A or a Wrench), in fixed-size
+// segments: Eigen's comma initializer and a returned temporary each cost
+// more than the arithmetic, which runs for every statics evaluation.
+template <typename Column>
+void write_column_h(const CableGeometry& g, Column&& c) {
+  c.template head<3>() = -g.s_c;
+  c.template tail<3>() = -g.lever_world.cross(g.s_c);
 }
-Wrench column_v(const CableGeometry& g) {
-  Wrench c;
-  c.head<3>() = kUp;
-  c.tail<3>() = g.lever_world.cross(kUp);
-  return c;
+template <typename Column>
+void write_column_v(const CableGeometry& g, Column&& c) {
+  c.template head<3>() = kUp;
+  c.template tail<3>() = g.lever_world.cross(kUp);
 }
 
 // LU with partial pivoting of the 6x6 matrix of Eq. (11), in plain loops:
@@ -132,7 +130,8 @@ StaticsStatus set_up(const Robot& robot, const StaticsInput& in, Setup& s,
   for (int i = 0; i < kCableCount; ++i) {
     const Eigen::Vector3d& b = robot.winches[i].attachment_platform;
     CableGeometry& g = s.geo[i];
-    g.lever_world = s.R * b;
+    // lazyProduct: the same sums as `*`, which here calls an out-of-line product.
+    g.lever_world = s.R.lazyProduct(b);
     const Eigen::Vector3d d = p + g.lever_world - in.anchor_world[i];
     // Spans are metres: their squares neither overflow nor underflow, so
     // the plain root is exact enough and costs far less than std::hypot.
@@ -147,7 +146,7 @@ StaticsStatus set_up(const Robot& robot, const StaticsInput& in, Setup& s,
   // Eq. (6): the cables carry the weight, acting at the centre of mass.
   const double weight_n = robot.platform_mass_kg * robot.gravity_mps2;
   s.com_platform = robot.center_of_mass_platform + in.com_offset_platform;
-  const Eigen::Vector3d com_world = s.R * s.com_platform;
+  const Eigen::Vector3d com_world = s.R.lazyProduct(s.com_platform);
   s.w.head<3>() = weight_n * kUp;
   s.w.tail<3>() = weight_n * com_world.cross(kUp);
 
@@ -155,11 +154,11 @@ StaticsStatus set_up(const Robot& robot, const StaticsInput& in, Setup& s,
   const int ref = robot.reference_cable;
   for (int i = 0, col = 0; i < kCableCount; ++i) {
     if (i == ref) continue;
-    s.A.col(col++) = column_h(s.geo[i]);
-    s.A.col(col++) = column_v(s.geo[i]);
+    write_column_h(s.geo[i], s.A.col(col++));
+    write_column_v(s.geo[i], s.A.col(col++));
   }
-  s.column_h_ref = column_h(s.geo[ref]);
-  s.column_v_ref = column_v(s.geo[ref]);
+  write_column_h(s.geo[ref], s.column_h_ref);
+  write_column_v(s.geo[ref], s.column_v_ref);
   return StaticsStatus::kOk;
 }
 
