@@ -163,7 +163,7 @@ bool singular(const Lu6& lu) { return !(std::abs(lu.determinant()) > 1e-12); }
 // Eigen fills a whole matrix with a constant by std::fill_n, a scalar loop
 // of 23 stores here; through a block view the same zeros are an unrolled,
 // vectorised assignment.
-void set_zero(StaticsRow& row) { row.segment<kStaticsParamDim>(0).setZero(); }
+inline void set_zero(StaticsRow& row) { row.segment<kStaticsParamDim>(0).setZero(); }
 
 // The right-hand sides of the statics Jacobian (see solve_platform_statics)
 // by column: u_0..3, rotation (3), centre of mass (3), reference force (2).
