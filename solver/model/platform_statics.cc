@@ -32,14 +32,19 @@ void write_column_v(const CableGeometry& g, Column&& c) {
   c.template tail<3>() = g.lever_world.cross(kUp);
 }
 
-// LU with partial pivoting of the 6x6 matrix of Eq. (11), in fixed-size
-// row operations: the statics solve it for one right-hand side and, with
-// Jacobians, a dozen more, where a generic blocked solver costs more than
-// the arithmetic. Rows are stored contiguously, so the elimination's row
-// updates and swaps vectorise.
+// LU with partial pivoting of the 6x6 matrix of Eq. (11), in plain loops:
+// the statics solve it for one right-hand side and, with Jacobians, a dozen
+// more, where a generic blocked solver costs more than the arithmetic.
 class Lu6 {
  public:
-  explicit Lu6(const Eigen::Matrix<double, 6, 6>& a) : lu_(a) { eliminate<0>(); }
+  explicit Lu6(const Eigen::Matrix<double, 6, 6>& a) {
+#pragma GCC unroll 6
+    for (int r = 0; r < 6; ++r) {
+#pragma GCC unroll 6
+      for (int c = 0; c < 6; ++c) lu_[r][c] = a(r, c);
+    }
+    eliminate<0>();
+  }
   double determinant() const { return determinant_; }
   // A^-1 b for one right-hand side (a Wrench) or, row-major, N of them at
   // once: each step of the substitutions is then one row operation over
@@ -53,12 +58,12 @@ class Lu6 {
     for (int r = 0; r < 6; ++r) {
       x.row(r) = b.row(row_of_[r]);
 #pragma GCC unroll 6
-      for (int c = 0; c < r; ++c) x.row(r) -= lu_(r, c) * x.row(c);
+      for (int c = 0; c < r; ++c) x.row(r) -= lu_[r][c] * x.row(c);
     }
 #pragma GCC unroll 6
     for (int r = 5; r >= 0; --r) {
 #pragma GCC unroll 6
-      for (int c = r + 1; c < 6; ++c) x.row(r) -= lu_(r, c) * x.row(c);
+      for (int c = r + 1; c < 6; ++c) x.row(r) -= lu_[r][c] * x.row(c);
       x.row(r) *= inverse_diagonal_[r];
     }
     return x;
@@ -74,14 +79,15 @@ class Lu6 {
       int pivot = K;
 #pragma GCC unroll 6
       for (int r = K + 1; r < 6; ++r) {
-        if (std::abs(lu_(r, K)) > std::abs(lu_(pivot, K))) pivot = r;
+        if (std::abs(lu_[r][K]) > std::abs(lu_[pivot][K])) pivot = r;
       }
       if (pivot != K) {
         std::swap(row_of_[K], row_of_[pivot]);
-        lu_.row(K).swap(lu_.row(pivot));
+#pragma GCC unroll 6
+        for (int c = 0; c < 6; ++c) std::swap(lu_[K][c], lu_[pivot][c]);
         determinant_ = -determinant_;
       }
-      const double diagonal = lu_(K, K);
+      const double diagonal = lu_[K][K];
       determinant_ *= diagonal;
       if (diagonal == 0.0) {  // singular: determinant 0, the caller refuses
         inverse_diagonal_[K] = 0.0;
@@ -89,17 +95,17 @@ class Lu6 {
         inverse_diagonal_[K] = 1.0 / diagonal;
 #pragma GCC unroll 6
         for (int r = K + 1; r < 6; ++r) {
-          const double factor = lu_(r, K) * inverse_diagonal_[K];
-          lu_(r, K) = factor;
-          // The rest of row r as one (vectorised) row operation.
-          lu_.row(r).template tail<5 - K>() -= factor * lu_.row(K).template tail<5 - K>();
+          const double factor = lu_[r][K] * inverse_diagonal_[K];
+          lu_[r][K] = factor;
+#pragma GCC unroll 6
+          for (int c = K + 1; c < 6; ++c) lu_[r][c] -= factor * lu_[K][c];
         }
       }
       eliminate<K + 1>();
     }
   }
 
-  Eigen::Matrix<double, 6, 6, Eigen::RowMajor> lu_;
+  double lu_[6][6];
   double inverse_diagonal_[6];
   int row_of_[6] = {0, 1, 2, 3, 4, 5};  // row r of P A is row row_of_[r] of A
   double determinant_ = 1.0;
