@@ -17,6 +17,22 @@ struct CableGeometry {
   double span = 0.0;
 };
 
+// out = f(a x b) entry by entry, each entry as Eigen's cross computes it.
+// Assigning a.cross(b) (or f of it) to part of a vector instead goes
+// through a temporary stored an entry at a time and reloaded two at a
+// time: a load the CPU cannot forward from those stores, so it waits for
+// them to reach the cache, in the statics' hottest loops.
+template <typename Out, typename F>
+void set_cross(const Eigen::Vector3d& a, const Eigen::Vector3d& b, Out&& out, F f) {
+  out(0) = f(a.y() * b.z() - a.z() * b.y());
+  out(1) = f(a.z() * b.x() - a.x() * b.z());
+  out(2) = f(a.x() * b.y() - a.y() * b.x());
+}
+template <typename Out>
+void set_cross(const Eigen::Vector3d& a, const Eigen::Vector3d& b, Out&& out) {
+  set_cross(a, b, out, [](double x) { return x; });
+}
+
 // Wrench columns of J^T for one cable, Eq. (8): f_h acts along -s_c, f_v
 // along +z. Written in place (a column of A or a Wrench), in fixed-size
 // segments: Eigen's comma initializer and a returned temporary each cost
@@ -24,12 +40,12 @@ struct CableGeometry {
 template <typename Column>
 void write_column_h(const CableGeometry& g, Column&& c) {
   c.template head<3>() = -g.s_c;
-  c.template tail<3>() = -g.lever_world.cross(g.s_c);
+  set_cross(g.lever_world, g.s_c, c.template tail<3>(), [](double x) { return -x; });
 }
 template <typename Column>
 void write_column_v(const CableGeometry& g, Column&& c) {
   c.template head<3>() = kUp;
-  c.template tail<3>() = g.lever_world.cross(kUp);
+  set_cross(g.lever_world, kUp, c.template tail<3>());
 }
 
 // LU with partial pivoting of the 6x6 matrix of Eq. (11), in plain loops:
@@ -148,7 +164,7 @@ StaticsStatus set_up(const Robot& robot, const StaticsInput& in, Setup& s,
   s.com_platform = robot.center_of_mass_platform + in.com_offset_platform;
   const Eigen::Vector3d com_world = s.R.lazyProduct(s.com_platform);
   s.w.head<3>() = weight_n * kUp;
-  s.w.tail<3>() = weight_n * com_world.cross(kUp);
+  set_cross(com_world, kUp, s.w.tail<3>(), [weight_n](double x) { return weight_n * x; });
 
   // Eq. (9)-(11): partition J^T into the reference cable and the rest.
   const int ref = robot.reference_cable;
@@ -345,12 +361,12 @@ StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in,
     const Eigen::Vector3d force_platform = -f_h * s_c_platform[i] + cables[i].f_v * up_platform;
     phi[i](0) = t.x() / g.span;
     phi[i](1) = t.y() / g.span;
-    phi[i].segment<3>(2) = b.cross(t_platform).transpose() / g.span;
+    set_cross(b, t_platform, phi[i].segment<3>(2), [&g](double x) { return x / g.span; });
     phi[i](5) = -t.x() / g.span;
     phi[i](6) = -t.y() / g.span;
     e.col(kU + i).head<3>() = f_h * t;
     e.col(kU + i).tail<3>() = f_h * g.lever_world.cross(t);
-    n -= b * force_platform.transpose();
+    n.noalias() -= b * force_platform.transpose();  // by columns, no temporary (see set_cross)
     n.diagonal().array() += force_platform.dot(b);
   }
   e.block<3, 3>(3, kRotation) = R * n;
@@ -370,7 +386,7 @@ StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in,
     set_zero(c.d_span);
     c.d_span(kStaticsPose) = g.s_c.x();
     c.d_span(kStaticsPose + 1) = g.s_c.y();
-    c.d_span.segment<3>(kStaticsPose + 3) = robot.winches[i].attachment_platform.cross(s_c_platform[i]).transpose();
+    set_cross(robot.winches[i].attachment_platform, s_c_platform[i], c.d_span.segment<3>(kStaticsPose + 3));
     c.d_span(anchor) = -g.s_c.x();
     c.d_span(anchor + 1) = -g.s_c.y();
     set_zero(c.d_anchor_z);
@@ -378,7 +394,7 @@ StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in,
     // The attachment moves with the pose, not with the anchor.
     set_zero(c.d_attachment_z);
     c.d_attachment_z(kStaticsPose + 2) = 1.0;
-    c.d_attachment_z.segment<3>(kStaticsPose + 3) = robot.winches[i].attachment_platform.cross(up_platform).transpose();
+    set_cross(robot.winches[i].attachment_platform, up_platform, c.d_attachment_z.segment<3>(kStaticsPose + 3));
     if (i == ref) {
       set_zero(c.d_f_h);
       set_zero(c.d_f_v);
