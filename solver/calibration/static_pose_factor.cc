@@ -21,8 +21,8 @@ struct ChainWeights {
 };
 
 // Rows `cable` (encoder, Eq. 14) and kCableCount + cable (height, Eq. 15) of
-// the factor's Jacobian blocks (pose, reference force, anchors; zero in the
-// offsets), straight from the cable's statics rows; the height row adds
+// the factor's Jacobian blocks of pose, reference force and anchors (the
+// offsets' are write_offset_columns'), straight from the cable's statics rows; the height row adds
 // `height_attachment_z` times the attachment height's row. Only the forces
 // depend on everything; the geometry does not (platform_statics.h): the
 // span depends on the pose and the cable's own anchor, the anchor height on
@@ -60,7 +60,6 @@ void write_chain_rows(const CableStatics& c, int cable, const ChainWeights& enco
         height_part += height.span * span + height.anchor_z * anchor_z;
       }
     }
-    if (double* offset = jacobians[2 + kCableCount + i]) offset[encoder_row] = offset[height_row] = 0.0;
   }
 }
 
@@ -70,7 +69,17 @@ void write_force_row(const Eigen::Vector2d& d_force, int r, double* const* jacob
   if (jacobians[1]) for (int c = 0; c < 2; ++c) jacobians[1][r * 2 + c] = d_force(c);
   for (int i = 0; i < kCableCount; ++i) {
     if (jacobians[2 + i]) for (int c = 0; c < 3; ++c) jacobians[2 + i][r * 3 + c] = 0.0;
-    if (jacobians[2 + kCableCount + i]) jacobians[2 + kCableCount + i][r] = 0.0;
+  }
+}
+
+// Offset i reaches its own encoder row alone (Eq. 14): each offset's
+// column is written whole, once.
+void write_offset_columns(const std::array<double, kCableCount>& sigma_encoder, double* const* jacobians) {
+  for (int i = 0; i < kCableCount; ++i) {
+    if (double* offset = jacobians[2 + kCableCount + i]) {
+      Eigen::Map<Eigen::Matrix<double, StaticPoseFactor::kResidualDim, 1>>(offset).setZero();
+      offset[i] = 1.0 / sigma_encoder[i];
+    }
   }
 }
 
@@ -124,7 +133,6 @@ bool StaticPoseFactor::evaluate(const double* const* parameters, double* residua
     write_chain_rows(c, i, {dl(0) * to_encoder, dl(1) * to_encoder, dl(2) * to_encoder, dl(3) * to_encoder},
                      {-dz(0) * to_height, -dz(1) * to_height, -dz(2) * to_height, -dz(3) * to_height}, to_height,
                      jacobians);
-    if (jacobians[2 + kCableCount + i]) jacobians[2 + kCableCount + i][i] = 1.0 / sigma_encoder;
   }
 
   // Eq. (16): the load cell measures the tension magnitude of the reference cable.
@@ -136,6 +144,7 @@ bool StaticPoseFactor::evaluate(const double* const* parameters, double* residua
     const Eigen::Vector2d d_force =
         tension > 0.0 ? Eigen::Vector2d(in.reference_force / (tension * sigma_force)) : Eigen::Vector2d::Zero();
     write_force_row(d_force, force_row, jacobians);
+    write_offset_columns(sigma_.encoder_m, jacobians);
   }
   zero_rows(std::span(left_out_.rows.data(), left_out_.count), residual, jacobians, kStaticPoseBlockDims);
   *cost = apply_loss_to_rows(loss_, kReadingRows, kResidualDim, residual, jacobians, kStaticPoseBlockDims);

@@ -17,21 +17,35 @@ struct CableGeometry {
   double span = 0.0;
 };
 
-// Wrench columns of J^T for one cable, Eq. (8): f_h acts along -s_c, f_v along +z.
-// (Fixed-size segments, not Eigen's comma initializer: these run for every
-// statics evaluation, and the initializer's runtime bookkeeping cost more
-// than the arithmetic.)
-Wrench column_h(const CableGeometry& g) {
-  Wrench c;
-  c.head<3>() = -g.s_c;
-  c.tail<3>() = -g.lever_world.cross(g.s_c);
-  return c;
+// out = f(a x b) entry by entry, each entry as Eigen's cross computes it.
+// Assigning a.cross(b) (or f of it) to part of a vector instead goes
+// through a temporary stored an entry at a time and reloaded two at a
+// time: a load the CPU cannot forward from those stores, so it waits for
+// them to reach the cache, in the statics' hottest loops.
+template <typename Out, typename F>
+void set_cross(const Eigen::Vector3d& a, const Eigen::Vector3d& b, Out&& out, F f) {
+  out(0) = f(a.y() * b.z() - a.z() * b.y());
+  out(1) = f(a.z() * b.x() - a.x() * b.z());
+  out(2) = f(a.x() * b.y() - a.y() * b.x());
 }
-Wrench column_v(const CableGeometry& g) {
-  Wrench c;
-  c.head<3>() = kUp;
-  c.tail<3>() = g.lever_world.cross(kUp);
-  return c;
+template <typename Out>
+void set_cross(const Eigen::Vector3d& a, const Eigen::Vector3d& b, Out&& out) {
+  set_cross(a, b, out, [](double x) { return x; });
+}
+
+// Wrench columns of J^T for one cable, Eq. (8): f_h acts along -s_c, f_v
+// along +z. Written in place (a column of A or a Wrench), in fixed-size
+// segments: Eigen's comma initializer and a returned temporary each cost
+// more than the arithmetic, which runs for every statics evaluation.
+template <typename Column>
+void write_column_h(const CableGeometry& g, Column&& c) {
+  c.template head<3>() = -g.s_c;
+  set_cross(g.lever_world, g.s_c, c.template tail<3>(), [](double x) { return -x; });
+}
+template <typename Column>
+void write_column_v(const CableGeometry& g, Column&& c) {
+  c.template head<3>() = kUp;
+  set_cross(g.lever_world, kUp, c.template tail<3>());
 }
 
 // LU with partial pivoting of the 6x6 matrix of Eq. (11), in plain loops:
@@ -132,7 +146,8 @@ StaticsStatus set_up(const Robot& robot, const StaticsInput& in, Setup& s,
   for (int i = 0; i < kCableCount; ++i) {
     const Eigen::Vector3d& b = robot.winches[i].attachment_platform;
     CableGeometry& g = s.geo[i];
-    g.lever_world = s.R * b;
+    // lazyProduct: the same sums as `*`, which here calls an out-of-line product.
+    g.lever_world = s.R.lazyProduct(b);
     const Eigen::Vector3d d = p + g.lever_world - in.anchor_world[i];
     // Spans are metres: their squares neither overflow nor underflow, so
     // the plain root is exact enough and costs far less than std::hypot.
@@ -147,19 +162,19 @@ StaticsStatus set_up(const Robot& robot, const StaticsInput& in, Setup& s,
   // Eq. (6): the cables carry the weight, acting at the centre of mass.
   const double weight_n = robot.platform_mass_kg * robot.gravity_mps2;
   s.com_platform = robot.center_of_mass_platform + in.com_offset_platform;
-  const Eigen::Vector3d com_world = s.R * s.com_platform;
+  const Eigen::Vector3d com_world = s.R.lazyProduct(s.com_platform);
   s.w.head<3>() = weight_n * kUp;
-  s.w.tail<3>() = weight_n * com_world.cross(kUp);
+  set_cross(com_world, kUp, s.w.tail<3>(), [weight_n](double x) { return weight_n * x; });
 
   // Eq. (9)-(11): partition J^T into the reference cable and the rest.
   const int ref = robot.reference_cable;
   for (int i = 0, col = 0; i < kCableCount; ++i) {
     if (i == ref) continue;
-    s.A.col(col++) = column_h(s.geo[i]);
-    s.A.col(col++) = column_v(s.geo[i]);
+    write_column_h(s.geo[i], s.A.col(col++));
+    write_column_v(s.geo[i], s.A.col(col++));
   }
-  s.column_h_ref = column_h(s.geo[ref]);
-  s.column_v_ref = column_v(s.geo[ref]);
+  write_column_h(s.geo[ref], s.column_h_ref);
+  write_column_v(s.geo[ref], s.column_v_ref);
   return StaticsStatus::kOk;
 }
 
@@ -170,7 +185,7 @@ bool singular(const Lu6& lu) { return !(std::abs(lu.determinant()) > 1e-12); }
 // Eigen fills a whole matrix with a constant by std::fill_n, a scalar loop
 // of 23 stores here; through a block view the same zeros are an unrolled,
 // vectorised assignment.
-void set_zero(StaticsRow& row) { row.segment<kStaticsParamDim>(0).setZero(); }
+inline void set_zero(StaticsRow& row) { row.segment<kStaticsParamDim>(0).setZero(); }
 
 // The right-hand sides of the statics Jacobian (see solve_platform_statics)
 // by column: u_0..3, rotation (3), centre of mass (3), reference force (2).
@@ -346,12 +361,12 @@ StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in,
     const Eigen::Vector3d force_platform = -f_h * s_c_platform[i] + cables[i].f_v * up_platform;
     phi[i](0) = t.x() / g.span;
     phi[i](1) = t.y() / g.span;
-    phi[i].segment<3>(2) = b.cross(t_platform).transpose() / g.span;
+    set_cross(b, t_platform, phi[i].segment<3>(2), [&g](double x) { return x / g.span; });
     phi[i](5) = -t.x() / g.span;
     phi[i](6) = -t.y() / g.span;
     e.col(kU + i).head<3>() = f_h * t;
     e.col(kU + i).tail<3>() = f_h * g.lever_world.cross(t);
-    n -= b * force_platform.transpose();
+    n.noalias() -= b * force_platform.transpose();  // by columns, no temporary (see set_cross)
     n.diagonal().array() += force_platform.dot(b);
   }
   e.block<3, 3>(3, kRotation) = R * n;
@@ -371,7 +386,7 @@ StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in,
     set_zero(c.d_span);
     c.d_span(kStaticsPose) = g.s_c.x();
     c.d_span(kStaticsPose + 1) = g.s_c.y();
-    c.d_span.segment<3>(kStaticsPose + 3) = robot.winches[i].attachment_platform.cross(s_c_platform[i]).transpose();
+    set_cross(robot.winches[i].attachment_platform, s_c_platform[i], c.d_span.segment<3>(kStaticsPose + 3));
     c.d_span(anchor) = -g.s_c.x();
     c.d_span(anchor + 1) = -g.s_c.y();
     set_zero(c.d_anchor_z);
@@ -379,7 +394,7 @@ StaticsStatus solve_platform_statics(const Robot& robot, const StaticsInput& in,
     // The attachment moves with the pose, not with the anchor.
     set_zero(c.d_attachment_z);
     c.d_attachment_z(kStaticsPose + 2) = 1.0;
-    c.d_attachment_z.segment<3>(kStaticsPose + 3) = robot.winches[i].attachment_platform.cross(up_platform).transpose();
+    set_cross(robot.winches[i].attachment_platform, up_platform, c.d_attachment_z.segment<3>(kStaticsPose + 3));
     if (i == ref) {
       set_zero(c.d_f_h);
       set_zero(c.d_f_v);
