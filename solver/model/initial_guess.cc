@@ -164,8 +164,13 @@ bool damped_gauss_newton(Eigen::Matrix<double, N, 1>& x, const Evaluate& evaluat
   for (int iteration = 0; iteration < 50 && !strategy.collapsed(); ++iteration) {
     const Vector gradient = jacobian.transpose() * residual;
     const Eigen::Matrix<double, N, N> jtj = jacobian.transpose() * jacobian;
-    Eigen::Matrix<double, N, N> H = jtj;
-    H.diagonal() *= 1.0 + strategy.damping();
+    // H = J'J with its diagonal times 1 + damping, as one whole-matrix
+    // expression (every other entry times exactly 1): scaling H's diagonal
+    // in place stores it an entry at a time, and the LDLT in `propose`
+    // reloads H two entries at a time, a load the CPU cannot forward from
+    // those stores; it waits for them to reach the cache.
+    static const Eigen::Array<double, N, N> kIdentity = Eigen::Matrix<double, N, N>::Identity().array();
+    const Eigen::Matrix<double, N, N> H = (jtj.array() * (1.0 + strategy.damping() * kIdentity)).matrix();
     const Vector trial = propose(x, H, gradient);
     const Vector step = trial - x;
     // The cost is |r|^2: the undamped model's decrease is -(2 g's + s'J'Js).

@@ -28,7 +28,13 @@ Eigen::Quaterniond so3_exp(const Eigen::Vector3d& rotation_vector) {
     w = std::cos(0.5 * theta);
     s = std::sin(0.5 * theta) / theta;
   }
-  return Eigen::Quaterniond(w, s * rotation_vector.x(), s * rotation_vector.y(), s * rotation_vector.z());
+  // Written as two pairs (x, y) and (z, w), the halves Eigen's quaternion
+  // product loads: (z, w) written one entry at a time made that load wait
+  // for both stores to reach the cache, as the CPU cannot forward it from them.
+  Eigen::Quaterniond q;
+  q.coeffs().head<2>() = s * rotation_vector.head<2>();
+  q.coeffs().tail<2>() = Eigen::Vector2d(s * rotation_vector.z(), w);
+  return q;
 }
 
 Eigen::Vector3d so3_log(const Eigen::Quaterniond& q_in) {
