@@ -89,8 +89,6 @@ struct TermTest {
   bool asked_for = false;  // p below the per-term level
 };
 
-// One pose of the final fit as it ended: the row as fitted (gross errors
-// masked), its platform pose and the reference cable's force (f_h, f_v).
 // A row's part of a fit's last linearisation (whitened, after the loss:
 // LevenbergMarquardt::last_residuals, last_jacobian): its reading factor's
 // residuals and Jacobian blocks of the pose, reference force, anchors and
@@ -106,6 +104,8 @@ struct FittedRowLinearization {
   std::array<double, kPriorRows * 6> prior_jacobian{};
 };
 
+// One pose of the final fit as it ended: the row as fitted (gross errors
+// masked), its platform pose and the reference cable's force (f_h, f_v).
 struct FittedRow {
   Sample sample;
   Pose world_T_platform;

@@ -337,7 +337,9 @@ CalibrationResult calibrate_once(const Robot& robot, const std::vector<Sample>& 
   // final fit's first. When the robust stage also converged there, that
   // point is the final fit's minimum: the final cost, gradient and
   // curvature are the robust stage's own, so the final solve would only
-  // confirm it with one more step.
+  // confirm it with one more step. What reads the last linearisation below
+  // (covariance, reading residuals, fitted rows) then reads the robust
+  // stage's, which is bit for bit the final loss's.
   const bool same = options.robust && same_linearization(built, lm, *built.reading_loss, final_loss, catenary);
   *built.reading_loss = final_loss;
   if (same && robust_summary.termination == TerminationType::kConverged) {
