@@ -208,9 +208,21 @@ void remove_unneeded_effects(Diagnosis& d, const Robot& robot, const std::vector
   }
 }
 
+// The level a round on top of `model` tests its candidates at: alpha over
+// the number of them (Bonferroni).
+double round_level(const std::vector<Effect>& model, const DiagnosisOptions& options) {
+  const auto untried = std::count_if(options.candidates.begin(), options.candidates.end(),
+                                     [&](Effect e) { return can_add(model, e); });
+  return options.alpha / static_cast<double>(std::max<std::ptrdiff_t>(1, untried));
+}
+
 // Back to the narrower form of a term whose extra parameters are not
 // significant with everything else in the model: a load-cell gain taken
 // while an elasticity was still missing is often no gain once it is there.
+// The wide term entered on its narrow part's strength (bias and gain tested
+// together), so its extra parameters must pass the bar any term meets to
+// enter: a round's level on top of the narrowed model. At alpha alone a gain
+// that is only noise would stay in one data set of a hundred.
 void narrow_wide_effects(Diagnosis& d, const Robot& robot, const std::vector<Sample>& samples,
                          const DiagnosisOptions& options) {
   for (Effect narrow : kAllEffects) {
@@ -222,11 +234,13 @@ void narrow_wide_effects(Diagnosis& d, const Robot& robot, const std::vector<Sam
     narrowed[static_cast<std::size_t>(wide - model.begin())] = narrow;
     CalibrationResult fit = fit_all(robot, samples, options, narrowed);
     const FitComparison lr = compare_fits(fit, d.steps.back().fit);
-    if (!lr.comparable || lr.p_value < options.alpha) continue;
+    const double level = round_level(narrowed, options);
+    if (!lr.comparable || lr.p_value < level) continue;
     HeldOutEvaluation f = cross_validate(robot, samples, options, narrowed);
     if (!f.ok) continue;
     report(options, "narrow " + std::string(effect_model_name(was)) + " to " + std::string(effect_model_name(narrow)) +
-                        ": its extra parameters are not significant (p " + scientific(lr.p_value) + ")");
+                        ": its extra parameters are not significant (p " + scientific(lr.p_value) + ", needs p < " +
+                        scientific(level) + ")");
     d.steps.push_back({narrowed, narrow, std::move(fit), std::move(f), {}, was});
   }
 }

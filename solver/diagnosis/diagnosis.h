@@ -27,7 +27,8 @@
 // Backward steps, once nothing more is significant: an added term not
 // significant (alpha, likelihood ratio on all samples) with the rest of the
 // model is removed, the least needed first; a wider term whose extra
-// parameters are not significant goes back to its narrower form.
+// parameters are not significant at a round's level (alpha / m) goes back to
+// its narrower form.
 //
 // Finally it says whether the held-out misfit is still above the noise:
 // structure that no known effect explains. Pure numerics: progress goes

@@ -143,6 +143,7 @@ TEST(HiddenEffectRun, TheOperatorCommitsTheNamedLoadCellBiasWithCalibctl) {
   // AND its model check names load_cell_bias, and calibctl status says how to commit with it
   const calibctl::JsonValue run = model_check_of_last_run(rig);
   ASSERT_FALSE(run["diagnosis"].string().empty());
+  std::printf("model check: %s\n", run["diagnosis"].string().c_str());
   ASSERT_EQ(run["named_terms"].array().size(), 1u) << run["diagnosis"].string();
   EXPECT_EQ(run["named_terms"].array()[0].string(), "load_cell_bias");
   const std::string calibctl = built_program("tools/calibctl/calibctl");
