@@ -18,33 +18,16 @@
 #include "src/daemon/daemon_config.h"
 #include "virtual-robot/cia402_device.h"
 #include "virtual-robot/robot_physics.h"
+#include "drive_commands.h"
 #include "virtual_robot_rig.h"
 
 namespace cdpr::integration {
 namespace {
 
 constexpr double kMPerCount = 1e-5;
-constexpr double kVelocityMps = 2.0, kAccelerationMps2 = 1.0;  // the daemon's default profile
 constexpr int kMoves = 6;
 
-using virtual_robot::BusFrame;
 using virtual_robot::Cia402Device;
-
-void sdo_write(Cia402Device& d, std::uint16_t index, std::uint32_t value, int size, hal::TimeUs now_us) {
-  BusFrame f{0x600 + static_cast<std::uint32_t>(d.node_id()), 8, {}};
-  f.data = {static_cast<std::uint8_t>(0x23 | (4 - size) << 2), static_cast<std::uint8_t>(index),
-            static_cast<std::uint8_t>(index >> 8), 0, static_cast<std::uint8_t>(value),
-            static_cast<std::uint8_t>(value >> 8), static_cast<std::uint8_t>(value >> 16),
-            static_cast<std::uint8_t>(value >> 24)};
-  d.on_frame(f, now_us);
-}
-
-void controlword(Cia402Device& d, std::uint16_t cw, hal::TimeUs now_us) {
-  BusFrame f{0x200 + static_cast<std::uint32_t>(d.node_id()), 2, {}};
-  f.data[0] = static_cast<std::uint8_t>(cw);
-  f.data[1] = static_cast<std::uint8_t>(cw >> 8);
-  d.on_frame(f, now_us);
-}
 
 struct Excursion {
   double outside_band_n = 0.0;  // largest distance of a tension outside [rest before, rest after]
@@ -57,14 +40,12 @@ Excursion drive_through(const sim::TrueRobot& truth, const Eigen::Vector3d& star
   EXPECT_TRUE(physics) << physics.error();
   std::vector<std::unique_ptr<Cia402Device>> drives;
   hal::TimeUs now_us = 0;
-  std::vector<BusFrame> sink;
+  std::vector<virtual_robot::BusFrame> sink;
   for (int i = 0; i < kCableCount; ++i) {
     drives.push_back(std::make_unique<Cia402Device>(i + 1, virtual_robot::DriveDefaults{}));
     Cia402Device& d = *drives.back();
     d.set_initial_position(physics->payout_m(i) / kMPerCount);
-    d.on_frame(BusFrame{0x000, 2, {0x01, static_cast<std::uint8_t>(i + 1)}}, now_us);  // NMT start
-    sdo_write(d, 0x6060, 1, 1, now_us);
-    for (std::uint16_t cw : {0x06, 0x07, 0x0F}) controlword(d, cw, now_us);
+    enable_profile_position(d, now_us);
   }
   const auto step = [&](double dt_s) {
     now_us += static_cast<hal::TimeUs>(dt_s * 1e6);
@@ -88,12 +69,8 @@ Excursion drive_through(const sim::TrueRobot& truth, const Eigen::Vector3d& star
     for (int i = 0; i < kCableCount; ++i) {
       Cia402Device& d = *drives[i];
       const double share = coordinated ? std::abs(w.payout_m[i] - physics->payout_m(i)) / longest_m : 1.0;
-      sdo_write(d, 0x6081, static_cast<std::uint32_t>(std::max(1.0, share * kVelocityMps / kMPerCount)), 4, now_us);
-      sdo_write(d, 0x6083, static_cast<std::uint32_t>(std::max(1.0, share * kAccelerationMps2 / kMPerCount)), 4, now_us);
-      sdo_write(d, 0x6084, static_cast<std::uint32_t>(std::max(1.0, share * kAccelerationMps2 / kMPerCount)), 4, now_us);
-      sdo_write(d, 0x607A, static_cast<std::uint32_t>(static_cast<std::int32_t>(std::lround(w.payout_m[i] / kMPerCount))), 4,
-                now_us);
-      controlword(d, 0x3F, now_us);  // enable operation + new set-point + change immediately
+      start_move(d, static_cast<std::int32_t>(std::lround(w.payout_m[i] / kMPerCount)), share * kProfileVelocityMps / kMPerCount,
+                 share * kProfileAccelerationMps2 / kMPerCount, now_us);
     }
     std::vector<std::array<double, kCableCount>> during;
     for (int n = 0; n < 200'000; ++n) {
@@ -102,7 +79,7 @@ Excursion drive_through(const sim::TrueRobot& truth, const Eigen::Vector3d& star
       for (int i = 0; i < kCableCount; ++i) t[i] = physics->tension_n(i);
       during.push_back(t);
       if (n == 5) {
-        for (auto& d : drives) controlword(*d, 0x2F, now_us);  // finish the handshake
+        for (auto& d : drives) finish_move(*d, now_us);
       }
       bool still = n > 20;
       for (auto& d : drives) still = still && d->at_rest();

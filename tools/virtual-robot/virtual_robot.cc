@@ -2,6 +2,7 @@
 
 #include <poll.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -117,12 +118,24 @@ void VirtualRobot::run_once(hal::TimeUs max_wait_us) {
   }
   const hal::TimeUs now_us = clock_.now_us();
   modbus_->service(fds_, now_us);  // also sends replies whose latency has passed
-  const double dt_s = options_.time_scale * 1e-6 * static_cast<double>(now_us - last_us_);
-  nodes_->advance(dt_s);
-  physics_->advance(dt_s);
+  advance(options_.time_scale * 1e-6 * static_cast<double>(now_us - last_us_));
   last_us_ = now_us;
   for (int i = 0; i < kCableCount; ++i) payout_snapshot_m_[i].store(physics_->payout_m(i));
   publish(now_us);
+}
+
+void VirtualRobot::advance(double dt_s) {
+  // A long gap (the process starved of CPU, magnified by the time scale) is
+  // simulated in steps no longer than the physics' equilibrium interval. In
+  // one step the drives would move metres at once, the taut solve would
+  // start far from the new rest pose and find none, and the platform would
+  // hang on three cables for a moment: a load cell reading 0 N mid-move.
+  const double longest_s = std::max(1e-3, options_.physics.equilibrium_interval_s);
+  const int steps = std::max(1, static_cast<int>(std::ceil(dt_s / longest_s)));
+  for (int k = 0; k < steps; ++k) {
+    nodes_->advance(dt_s / steps);
+    physics_->advance(dt_s / steps);
+  }
 }
 
 void VirtualRobot::on_can_bytes(int client, std::string_view bytes) {

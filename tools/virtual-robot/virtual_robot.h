@@ -84,6 +84,9 @@ class VirtualRobot {
   void run_once(hal::TimeUs max_wait_us);
   // run_once() until `stop` becomes true.
   void run(const std::atomic<bool>& stop);
+  // Moves the drives and the physics on by dt_s of simulated time, as
+  // run_once() does from the clock (tests choose the steps).
+  void advance(double dt_s);
 
   std::string can_endpoint() const { return "unix:" + options_.dir + "/can.sock"; }
   std::string pose_endpoint() const { return "unix:" + options_.dir + "/pose.sock"; }
