@@ -7,11 +7,13 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -89,6 +91,43 @@ TEST(VirtualRobotStall, MovesEachInOneStepHangOnFourCablesAsInShortSteps) {
   }
   on_time.reset();
   starved.reset();
+  std::filesystem::remove_all(dir);
+}
+
+TEST(VirtualRobotStall, AStarvedPassSimulatesAtMostItsShareOfSolves) {
+  // GIVEN the acceptance robot at time scale 20, its drives starting the first move
+  const auto planned = plan_acceptance_robot(calibration::WaypointSelection::kSpread);
+  ASSERT_TRUE(planned);
+  char pattern[] = "/tmp/cdpr-stall-XXXXXX";
+  const std::string dir = mkdtemp(pattern);
+  auto robot = acceptance_robot(dir + "/robot");
+  ASSERT_TRUE(robot);
+  ASSERT_EQ(robot->time_scale(), 20.0);
+  const std::array<double, kCableCount>& target_m = planned->plan.waypoints.front().payout_m;
+  const double m_per_count = robot->options().nodes.drive_m_per_count;
+  for (int i = 0; i < kCableCount; ++i) {
+    start_move(robot->nodes().drive(i), static_cast<std::int32_t>(std::lround(target_m[i] / m_per_count)),
+               kProfileVelocityMps / m_per_count, kProfileAccelerationMps2 / m_per_count, 0);
+  }
+  robot->run_once(0);
+  std::array<double, kCableCount> before_m{};
+  for (int i = 0; i < kCableCount; ++i) before_m[i] = robot->physics().payout_m(i);
+
+  // WHEN its process gets no CPU for 0.3 s (6 s of robot time) and then one pass
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  robot->run_once(0);
+
+  // THEN that pass simulated only kMaxSolvesPerPass equilibrium intervals
+  // (0.2 s: 2 cm from rest at 1 m/s^2; the bound allows twice the time),
+  // not the 6 s (about 10 m)
+  const double simulated_s = virtual_robot::VirtualRobot::kMaxSolvesPerPass *
+                             robot->options().physics.equilibrium_interval_s;
+  const double farthest_m = 0.5 * kProfileAccelerationMps2 * (2.0 * simulated_s) * (2.0 * simulated_s);
+  double moved_m = 0.0;
+  for (int i = 0; i < kCableCount; ++i) moved_m = std::max(moved_m, std::abs(robot->physics().payout_m(i) - before_m[i]));
+  EXPECT_GT(moved_m, 0.0);
+  EXPECT_LT(moved_m, farthest_m);
+  robot.reset();
   std::filesystem::remove_all(dir);
 }
 

@@ -118,20 +118,24 @@ void VirtualRobot::run_once(hal::TimeUs max_wait_us) {
   }
   const hal::TimeUs now_us = clock_.now_us();
   modbus_->service(fds_, now_us);  // also sends replies whose latency has passed
-  advance(options_.time_scale * 1e-6 * static_cast<double>(now_us - last_us_));
+  // Catching up a long gap would take more solves than the gap had time
+  // for: starved of CPU, the process would fall further behind every pass.
+  advance(std::min(options_.time_scale * 1e-6 * static_cast<double>(now_us - last_us_),
+                   kMaxSolvesPerPass * longest_step_s()));
   last_us_ = now_us;
   for (int i = 0; i < kCableCount; ++i) payout_snapshot_m_[i].store(physics_->payout_m(i));
   publish(now_us);
 }
 
+double VirtualRobot::longest_step_s() const { return std::max(1e-3, options_.physics.equilibrium_interval_s); }
+
 void VirtualRobot::advance(double dt_s) {
-  // A long gap (the process starved of CPU, magnified by the time scale) is
-  // simulated in steps no longer than the physics' equilibrium interval. In
-  // one step the drives would move metres at once, the taut solve would
-  // start far from the new rest pose and find none, and the platform would
-  // hang on three cables for a moment: a load cell reading 0 N mid-move.
-  const double longest_s = std::max(1e-3, options_.physics.equilibrium_interval_s);
-  const int steps = std::max(1, static_cast<int>(std::ceil(dt_s / longest_s)));
+  // A long step (a gap magnified by the time scale) is simulated in steps no
+  // longer than the physics' equilibrium interval. In one step the drives
+  // would move metres at once, the taut solve would start far from the new
+  // rest pose and find none, and the platform would hang on three cables
+  // for a moment: a load cell reading 0 N mid-move.
+  const int steps = std::max(1, static_cast<int>(std::ceil(dt_s / longest_step_s())));
   for (int k = 0; k < steps; ++k) {
     nodes_->advance(dt_s / steps);
     physics_->advance(dt_s / steps);

@@ -21,8 +21,11 @@
 // on every single reading.
 // Time: simulated time runs time_scale times faster than the monotonic
 // clock (drive speeds, settling), while heartbeats, PDO and pose rates stay
-// in real time, as the daemon's timeouts are. Not thread-safe: one thread
-// calls run_once()/run().
+// in real time, as the daemon's timeouts are. A process starved of CPU
+// does not jump: one run_once() simulates at most kMaxSolvesPerPass
+// equilibrium intervals, so simulated time then runs slower than
+// time_scale (a slower robot) and the work of a pass stays bounded. Not
+// thread-safe: one thread calls run_once()/run().
 
 #include <array>
 #include <atomic>
@@ -77,6 +80,8 @@ Eigen::Vector3d start_position_world(sim::Preset preset);
 
 class VirtualRobot {
  public:
+  static constexpr int kMaxSolvesPerPass = 4;
+
   static Expected<std::unique_ptr<VirtualRobot>, std::string> create(const VirtualRobotOptions& options);
 
   // Serves the sockets for at most max_wait_us, then advances the physics to
@@ -112,6 +117,8 @@ class VirtualRobot {
 
  private:
   VirtualRobot(const VirtualRobotOptions& options, sim::SimulatedDataset data);
+  // The longest step advance() takes: the physics' equilibrium interval.
+  double longest_step_s() const;
   void publish(hal::TimeUs now_us);
   void on_can_bytes(int client, std::string_view bytes);
   void publish_pose(hal::TimeUs now_us);
