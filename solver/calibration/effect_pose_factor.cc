@@ -43,6 +43,9 @@ EffectPoseFactor::EffectPoseFactor(const Robot& robot, int pose_index, const Sam
       left_out_(left_out_rows(sample)),
       sigma_height_m_(row_height_sigma(robot, sample, sigma_height_m)),
       loss_(loss) {
+  const std::size_t blocks = 2 + 2 * kCableCount + effects.size();
+  keys_.reserve(blocks);
+  block_dims_.reserve(blocks);
   keys_ = {PoseKey(pose_index), ReferenceForceKey(pose_index)};
   block_dims_ = {6, 2};
   for (int i = 0; i < kCableCount; ++i) {
