@@ -127,6 +127,8 @@ TEST(VirtualRobotStall, AStarvedPassSimulatesAtMostItsShareOfSolves) {
   for (int i = 0; i < kCableCount; ++i) moved_m = std::max(moved_m, std::abs(robot->physics().payout_m(i) - before_m[i]));
   EXPECT_GT(moved_m, 0.0);
   EXPECT_LT(moved_m, farthest_m);
+  // AND the robot time left out is counted: the 6 s less what the passes simulated
+  EXPECT_GT(robot->robot_time_lost_s(), 20.0 * 0.3 - 2.0 * simulated_s);
   robot.reset();
   std::filesystem::remove_all(dir);
 }

@@ -93,7 +93,8 @@ int main(int argc, char** argv) {
               (*robot)->modbus_endpoint().c_str(), (*robot)->pose_endpoint().c_str());
   std::fflush(stdout);
   (*robot)->run(g_stop);
-  std::printf("virtual-robot: stopped (%d equilibrium solves failed, %d with a slack cable)\n",
-              (*robot)->physics().failed_solves(), (*robot)->physics().slack_solves());
+  std::printf("virtual-robot: stopped (%d equilibrium solves failed, %d with a slack cable; %.1f s of robot time "
+              "not simulated while starved of CPU)\n",
+              (*robot)->physics().failed_solves(), (*robot)->physics().slack_solves(), (*robot)->robot_time_lost_s());
   return 0;
 }

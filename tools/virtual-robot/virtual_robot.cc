@@ -120,8 +120,10 @@ void VirtualRobot::run_once(hal::TimeUs max_wait_us) {
   modbus_->service(fds_, now_us);  // also sends replies whose latency has passed
   // Catching up a long gap would take more solves than the gap had time
   // for: starved of CPU, the process would fall further behind every pass.
-  advance(std::min(options_.time_scale * 1e-6 * static_cast<double>(now_us - last_us_),
-                   kMaxSolvesPerPass * longest_step_s()));
+  const double elapsed_s = options_.time_scale * 1e-6 * static_cast<double>(now_us - last_us_);
+  const double step_s = std::min(elapsed_s, kMaxSolvesPerPass * longest_step_s());
+  robot_time_lost_s_ += elapsed_s - step_s;
+  advance(step_s);
   last_us_ = now_us;
   for (int i = 0; i < kCableCount; ++i) payout_snapshot_m_[i].store(physics_->payout_m(i));
   publish(now_us);

@@ -92,6 +92,10 @@ class VirtualRobot {
   // Moves the drives and the physics on by dt_s of simulated time, as
   // run_once() does from the clock (tests choose the steps).
   void advance(double dt_s);
+  // Robot time the passes left out while the process was starved of CPU
+  // (beyond kMaxSolvesPerPass intervals a pass): how much slower than its
+  // time scale this robot ran.
+  double robot_time_lost_s() const { return robot_time_lost_s_; }
 
   std::string can_endpoint() const { return "unix:" + options_.dir + "/can.sock"; }
   std::string pose_endpoint() const { return "unix:" + options_.dir + "/pose.sock"; }
@@ -142,6 +146,7 @@ class VirtualRobot {
   std::array<std::atomic<double>, kCableCount> payout_snapshot_m_{};
   std::map<int, std::string> can_partial_;  // per CAN client: bytes of an incomplete record
   hal::TimeUs last_us_ = 0;
+  double robot_time_lost_s_ = 0.0;
   hal::TimeUs start_us_ = 0;
   hal::TimeUs next_pose_us_ = 0;
   std::vector<drivers::can::CanFrame> frames_;
