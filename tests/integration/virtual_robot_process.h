@@ -9,6 +9,7 @@
 // waypoints).
 
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -66,7 +67,13 @@ class VirtualRobotProcess {
   ~VirtualRobotProcess() {
     robot_->signal(SIGTERM);
     robot_->wait_exit(slowed(std::chrono::seconds(30)));
-    if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
+    if (!::testing::Test::HasFailure()) {
+      std::filesystem::remove_all(dir);
+      return;
+    }
+    // Its exit line tells a starved robot (robot time lost) or a slack
+    // cable's solve from a fault of the daemon's.
+    std::printf("kept %s; the virtual robot's log:\n%s", dir.c_str(), robot_->log().c_str());
   }
 
   // cdpr-calibd on this configuration, behind `prefix` (e.g. unshare ... --), logging to <dir>/<name>.log.
