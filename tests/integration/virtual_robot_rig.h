@@ -5,6 +5,7 @@
 // another, and the test acting as calibctl through the control socket.
 
 #include <atomic>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <functional>
@@ -194,6 +195,12 @@ class VirtualRobotRig {
     stop_daemon();
     stop_robot.store(true);
     robot_thread.join();
+    if (::testing::Test::HasFailure() && robot) {
+      // What tells a starved robot or a slack cable's solve from a daemon fault.
+      std::printf("virtual robot: %d equilibrium solves failed, %d with a slack cable; %.1f s of robot time not "
+                  "simulated while starved of CPU\n",
+                  robot->physics().failed_solves(), robot->physics().slack_solves(), robot->robot_time_lost_s());
+    }
     if (!keep_dir) std::filesystem::remove_all(dir);
   }
 
