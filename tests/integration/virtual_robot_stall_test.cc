@@ -19,6 +19,8 @@
 #include <gtest/gtest.h>
 
 #include "drive_commands.h"
+#include "drivers/clock/monotonic_clock.h"
+#include "drivers/pose/pose_stream_source.h"
 #include "virtual_robot_rig.h"
 
 namespace cdpr::integration {
@@ -109,7 +111,16 @@ TEST(VirtualRobotStall, AStarvedPassSimulatesAtMostItsShareOfSolves) {
     start_move(robot->nodes().drive(i), static_cast<std::int32_t>(std::lround(target_m[i] / m_per_count)),
                kProfileVelocityMps / m_per_count, kProfileAccelerationMps2 / m_per_count, 0);
   }
-  robot->run_once(0);
+  // AND a pose stream client with the robot's first pose
+  drivers::MonotonicClock clock;
+  drivers::pose::PoseStreamSource pose(robot->pose_endpoint(), clock);
+  ASSERT_TRUE(pose.open().ok());
+  for (int k = 0; k < 100 && !pose.latest(); ++k) {
+    robot->run_once(10'000);
+    (void)pose.update(0);
+  }
+  ASSERT_TRUE(pose.latest());
+  const hal::TimeUs first_stamp_us = pose.latest()->source_time_us;
   std::array<double, kCableCount> before_m{};
   for (int i = 0; i < kCableCount; ++i) before_m[i] = robot->physics().payout_m(i);
 
@@ -117,6 +128,7 @@ TEST(VirtualRobotStall, AStarvedPassSimulatesAtMostItsShareOfSolves) {
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   robot->run_once(0);
   const double gap_s = 0.3 * robot->time_scale();
+  ASSERT_TRUE(pose.update(1'000'000).ok());
 
   // THEN that pass simulated only kMaxSolvesPerPass equilibrium intervals
   // (0.2 s: 2 cm from rest at 1 m/s^2; the bound allows twice the time),
@@ -131,6 +143,9 @@ TEST(VirtualRobotStall, AStarvedPassSimulatesAtMostItsShareOfSolves) {
   EXPECT_LT(moved_m, farthest_m);
   // AND the robot time left out is counted: the gap less what the passes simulated
   EXPECT_GT(robot->robot_time_lost_s(), gap_s - 2.0 * simulated_s);
+  // AND the pose stamps run on the robot's clock, not the gap's: the
+  // platform's speed over them is its own
+  EXPECT_LT(1e-6 * static_cast<double>(pose.latest()->source_time_us - first_stamp_us), gap_s / 2.0);
   robot.reset();
   std::filesystem::remove_all(dir);
 }

@@ -123,6 +123,7 @@ void VirtualRobot::run_once(hal::TimeUs max_wait_us) {
   const double elapsed_s = options_.time_scale * 1e-6 * static_cast<double>(now_us - last_us_);
   const double step_s = std::min(elapsed_s, kMaxSolvesPerPass * longest_step_s());
   robot_time_lost_s_ += elapsed_s - step_s;
+  robot_time_s_ += step_s;
   advance(step_s);
   last_us_ = now_us;
   for (int i = 0; i < kCableCount; ++i) payout_snapshot_m_[i].store(physics_->payout_m(i));
@@ -223,7 +224,9 @@ void VirtualRobot::publish_pose(hal::TimeUs now_us) {
   sample.platform_world = {position.x(), position.y(), position.z()};
   sample.world_R_platform = {rotation.w(), rotation.x(), rotation.y(), rotation.z()};
   sample.valid = true;
-  sample.source_time_us = start_us_ + static_cast<hal::TimeUs>(options_.time_scale * static_cast<double>(now_us - start_us_));
+  // The robot's own clock: the time its physics has run, so that speeds
+  // over the stamps are the platform's, also while it ran slow.
+  sample.source_time_us = start_us_ + static_cast<hal::TimeUs>(1e6 * robot_time_s_);
   const DeviceFault fault = pose_fault_.load();
   if (!pose_ || fault == DeviceFault::kSilent) return;
   pose_->broadcast(fault == DeviceFault::kGarbage ? std::string("\x01\x02 not a pose %%\n")

@@ -24,7 +24,8 @@
 // in real time, as the daemon's timeouts are. A process starved of CPU
 // does not jump: one run_once() simulates at most kMaxSolvesPerPass
 // equilibrium intervals, so simulated time then runs slower than
-// time_scale (a slower robot) and the work of a pass stays bounded. Not
+// time_scale (a slower robot, its pose stamps too) and the work of a pass
+// stays bounded. Not
 // thread-safe: one thread calls run_once()/run().
 
 #include <array>
@@ -147,6 +148,7 @@ class VirtualRobot {
   std::map<int, std::string> can_partial_;  // per CAN client: bytes of an incomplete record
   hal::TimeUs last_us_ = 0;
   double robot_time_lost_s_ = 0.0;
+  double robot_time_s_ = 0.0;  // simulated by run_once() since the start: the pose stamps' clock
   hal::TimeUs start_us_ = 0;
   hal::TimeUs next_pose_us_ = 0;
   std::vector<drivers::can::CanFrame> frames_;
