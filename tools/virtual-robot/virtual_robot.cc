@@ -122,12 +122,15 @@ void VirtualRobot::run_once(hal::TimeUs max_wait_us) {
   // for: starved of CPU, the process would fall further behind every pass.
   const double elapsed_s = options_.time_scale * 1e-6 * static_cast<double>(now_us - last_us_);
   const double step_s = std::min(elapsed_s, kMaxSolvesPerPass * longest_step_s());
-  robot_time_lost_s_ += elapsed_s - step_s;
   robot_time_s_ += step_s;
   advance(step_s);
   last_us_ = now_us;
   for (int i = 0; i < kCableCount; ++i) payout_snapshot_m_[i].store(physics_->payout_m(i));
   publish(now_us);
+}
+
+double VirtualRobot::robot_time_lost_s() const {
+  return options_.time_scale * 1e-6 * static_cast<double>(last_us_ - start_us_) - robot_time_s_;
 }
 
 double VirtualRobot::longest_step_s() const { return std::max(1e-3, options_.physics.equilibrium_interval_s); }

@@ -96,7 +96,7 @@ class VirtualRobot {
   // Robot time the passes left out while the process was starved of CPU
   // (beyond kMaxSolvesPerPass intervals a pass): how much slower than its
   // time scale this robot ran.
-  double robot_time_lost_s() const { return robot_time_lost_s_; }
+  double robot_time_lost_s() const;
 
   std::string can_endpoint() const { return "unix:" + options_.dir + "/can.sock"; }
   std::string pose_endpoint() const { return "unix:" + options_.dir + "/pose.sock"; }
@@ -147,7 +147,6 @@ class VirtualRobot {
   std::array<std::atomic<double>, kCableCount> payout_snapshot_m_{};
   std::map<int, std::string> can_partial_;  // per CAN client: bytes of an incomplete record
   hal::TimeUs last_us_ = 0;
-  double robot_time_lost_s_ = 0.0;
   double robot_time_s_ = 0.0;  // simulated by run_once() since the start: the pose stamps' clock
   hal::TimeUs start_us_ = 0;
   hal::TimeUs next_pose_us_ = 0;
