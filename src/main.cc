@@ -23,6 +23,7 @@
 
 #include "drivers/can/canopen_winch_bank.h"
 #include "drivers/clock/monotonic_clock.h"
+#include "drivers/clock/shared_clock.h"
 #include "drivers/common/load_cell_reader.h"
 #include "drivers/modbus/modbus_load_cell.h"
 #include "drivers/pose/pose_stream_source.h"
@@ -94,6 +95,11 @@ int main(int argc, char** argv) {
   std::string config_path = "/etc/cdpr-calib/cdpr-calibd.toml";
   app.add_option("--config,-c", config_path, "configuration file (keys: see the example cdpr-calibd.toml)")
       ->capture_default_str();
+  std::string sim_clock_path;
+  app.add_option("--sim-clock", sim_clock_path,
+                 "take time from a simulator's clock file (the virtual robot's <endpoints>/clock) instead of "
+                 "CLOCK_MONOTONIC, as ROS's use_sim_time: every timeout then counts the simulated robot's time. "
+                 "For tests and demos against the virtual robot, never on a robot");
   CLI11_PARSE(app, argc, argv);
 
   const auto config = daemon::read_daemon_config(config_path);
@@ -132,7 +138,20 @@ int main(int argc, char** argv) {
     return 1;
   }
 
-  drivers::MonotonicClock clock;
+  // The loop, the devices' time stamps and every timeout run on `clock`; the
+  // systemd watchdog stays on the monotonic clock, which systemd watches.
+  drivers::MonotonicClock monotonic_clock;
+  std::unique_ptr<drivers::SharedClock> sim_clock;
+  if (!sim_clock_path.empty()) {
+    hal::Status opened;
+    sim_clock = drivers::SharedClock::open(sim_clock_path, opened);
+    if (!sim_clock) {
+      log_line("--sim-clock: " + opened.to_string());
+      return 1;
+    }
+    log_line("time from the simulator's clock " + sim_clock_path + " (--sim-clock)");
+  }
+  const hal::Clock& clock = sim_clock ? static_cast<const hal::Clock&>(*sim_clock) : monotonic_clock;
   drivers::can::CanopenWinchBank winches(winch_config, drivers::can::make_can_connector(config->winches.endpoint));
   drivers::modbus::ModbusLoadCell modbus_load_cell(cell_config, clock);
   // The Modbus transaction (up to response timeout x tries) runs on the
@@ -149,7 +168,7 @@ int main(int argc, char** argv) {
   sigaction(SIGINT, &action, nullptr);
   std::signal(SIGPIPE, SIG_IGN);
 
-  SdNotifier notifier(clock);
+  SdNotifier notifier(monotonic_clock);
   daemon::DaemonLoop loop(*config, *robot, {winches, load_cell, pose, button.get()}, store, clock, notifier, log_line);
   if (const hal::Status started = loop.start(); !started.ok()) {
     log_line(started.to_string());

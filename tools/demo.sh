@@ -45,7 +45,9 @@ start_virtual_robot "$work" "$build" 20 "${DEMO_SEED:-7}" ${DEMO_EFFECTS:-}
 # The virtual robot's CANopen nodes and pose stream share one thread with its
 # physics, whose equilibrium solve can hold them past the shipped 500 ms
 # (a hard move, a busy machine); a real drive or tracker does not wait for
-# physics: hence the heartbeat and pose_stale_ms.
+# physics: hence the heartbeat and pose_stale_ms. The daemon runs on the
+# robot's clock (--sim-clock), so a robot starved of CPU by a busy machine
+# is a slower robot to it, not a silent node.
 write_daemon_config "$work" \
   winches="max_speed_mps = 100.0
 heartbeat_timeout_ms = 2000" \
@@ -53,7 +55,7 @@ heartbeat_timeout_ms = 2000" \
 pose_stale_ms = 2000"
 
 echo "== cdpr-calibd (foreground, state in $work/state)"
-"$build/src/cdpr-calibd" --config "$work/cdpr-calibd.toml" 2>"$work/daemon.log" &
+"$build/src/cdpr-calibd" --config "$work/cdpr-calibd.toml" --sim-clock "$work/robot/clock" 2>"$work/daemon.log" &
 pids+=($!)
 wait_for "$work/control" 30
 sleep 1  # let the CANopen nodes' first heartbeats arrive

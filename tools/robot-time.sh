@@ -51,7 +51,7 @@ heartbeat_timeout_ms = 5000" \
   limits="pose_stale_ms = 5000
 ${LIMITS_KEYS:-}"
 
-"$build/src/cdpr-calibd" --config "$work/cdpr-calibd.toml" 2>"$work/daemon.log" &
+"$build/src/cdpr-calibd" --config "$work/cdpr-calibd.toml" --sim-clock "$work/robot/clock" 2>"$work/daemon.log" &
 pids+=($!)
 wait_for "$work/control" 30
 sleep 1  # let the CANopen nodes' first heartbeats arrive

@@ -78,7 +78,9 @@ class VirtualRobotProcess {
 
   // cdpr-calibd on this configuration, behind `prefix` (e.g. unshare ... --), logging to <dir>/<name>.log.
   std::unique_ptr<ChildProcess> start_daemon(const std::string& name, std::vector<std::string> prefix = {}) const {
-    prefix.insert(prefix.end(), {built_program("src/cdpr-calibd"), "--config", config});
+    // On the robot's clock: a robot process starved of CPU is a slower robot, not a fault.
+    prefix.insert(prefix.end(),
+                  {built_program("src/cdpr-calibd"), "--config", config, "--sim-clock", dir + "/robot/clock"});
     return std::make_unique<ChildProcess>(prefix, dir + "/" + name + ".log");
   }
 

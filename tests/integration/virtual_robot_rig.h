@@ -19,7 +19,6 @@
 #include "calibctl/control_client.h"
 #include "calibctl/json_value.h"
 #include "drivers/can/canopen_winch_bank.h"
-#include "drivers/clock/monotonic_clock.h"
 #include "drivers/common/load_cell_reader.h"
 #include "drivers/modbus/modbus_load_cell.h"
 #include "drivers/pose/pose_stream_source.h"
@@ -27,7 +26,7 @@
 #include "sim/equilibrium.h"
 #include "src/calibration/waypoint_planner.h"
 #include "src/daemon/daemon_loop.h"
-#include "src/daemon/load_cell_presets.h"
+#include "drivers/modbus/load_cell_presets.h"
 #include "slowdown.h"
 #include "virtual-robot/virtual_robot.h"
 
@@ -55,7 +54,7 @@ inline daemon::DaemonConfig fast_daemon_config(const std::string& dir, const vir
   // vendor's preset and the indicator's decimal point.
   const virtual_robot::LoadCellModel model = robot.options().load_cell.model;
   config.load_cell.preset = virtual_robot::to_string(model);
-  config.load_cell.map = *daemon::load_cell_preset(config.load_cell.preset);
+  config.load_cell.map = *drivers::modbus::load_cell_preset(config.load_cell.preset);
   if (model != virtual_robot::LoadCellModel::kLegacyFloat32) config.load_cell.map.decimals = virtual_robot::kShownDecimals;
   config.load_cell.slave_id = robot.options().load_cell.unit_id;
   config.pose.endpoint = robot.pose_endpoint();
@@ -177,6 +176,9 @@ class VirtualRobotRig {
     if (before_start) before_start(*this);
     winches = std::make_unique<drivers::can::CanopenWinchBank>(
         config.winches, drivers::can::make_can_connector(config.winches.endpoint));
+    // The daemon runs on the robot's clock, as cdpr-calibd --sim-clock does:
+    // a robot thread starved of CPU is a slower robot, not a device fault.
+    const hal::Clock& clock = robot->clock();
     load_cell = std::make_unique<drivers::modbus::ModbusLoadCell>(config.load_cell, clock);
     load_cell_reader = std::make_unique<drivers::LoadCellReader>(
         *load_cell, clock,
@@ -218,7 +220,6 @@ class VirtualRobotRig {
   std::atomic<bool> stop_robot{false};
   std::thread robot_thread;
   daemon::DaemonConfig config;
-  drivers::MonotonicClock clock;
   std::unique_ptr<drivers::can::CanopenWinchBank> winches;
   std::unique_ptr<drivers::modbus::ModbusLoadCell> load_cell;
   std::unique_ptr<drivers::LoadCellReader> load_cell_reader;  // what the daemon reads, as in main()

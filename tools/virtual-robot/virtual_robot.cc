@@ -64,6 +64,9 @@ Expected<std::unique_ptr<VirtualRobot>, std::string> VirtualRobot::create(const 
   NodeLayout nodes = options.nodes;
   nodes.encoder_noise_m = options.noise_scale * robot->data_.true_robot.robot.noise.encoder_m;
   const hal::TimeUs now_us = robot->clock_.now_us();
+  hal::Status clock_status;
+  robot->robot_clock_ = drivers::SharedClock::create(options.dir + "/clock", now_us, clock_status);
+  if (!robot->robot_clock_) return Unexpected{clock_status.to_string()};
   robot->nodes_ = std::make_unique<CanopenNodes>(nodes, *robot->physics_,
                                                  sim::Rng::stream(options.seed, kStreamLiveNoise, 1), now_us);
   robot->start_us_ = robot->last_us_ = robot->next_pose_us_ = now_us;
@@ -125,8 +128,13 @@ void VirtualRobot::run_once(hal::TimeUs max_wait_us) {
   robot_time_s_ += step_s;
   advance(step_s);
   last_us_ = now_us;
+  robot_clock_->advance_to(robot_clock_us());
   for (int i = 0; i < kCableCount; ++i) payout_snapshot_m_[i].store(physics_->payout_m(i));
-  publish(now_us);
+  publish(robot_clock_->now_us());
+}
+
+hal::TimeUs VirtualRobot::robot_clock_us() const {
+  return start_us_ + static_cast<hal::TimeUs>(1e6 * robot_time_s_ / options_.time_scale);
 }
 
 double VirtualRobot::robot_time_lost_s() const {
@@ -156,7 +164,7 @@ void VirtualRobot::on_can_bytes(int client, std::string_view bytes) {
   for (; partial.size() - used >= drivers::can::kWireFrameBytes; used += drivers::can::kWireFrameBytes) {
     drivers::can::CanFrame frame;
     if (drivers::can::decode_wire_frame(reinterpret_cast<const std::uint8_t*>(partial.data() + used), frame)) {
-      nodes_->on_frame(frame, clock_.now_us());
+      nodes_->on_frame(frame, robot_clock_->now_us());
     }
   }
   partial.erase(0, used);

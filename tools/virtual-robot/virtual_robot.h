@@ -19,14 +19,21 @@
 // Physics (robot_physics.h) from the simulator's true equilibrium, with the
 // options' hidden effects; sensor noise per the preset (robot.toml [noise])
 // on every single reading.
+//   <dir>/clock       the robot's clock (drivers/clock/shared_clock.h), below
+//
 // Time: simulated time runs time_scale times faster than the monotonic
-// clock (drive speeds, settling), while heartbeats, PDO and pose rates stay
-// in real time, as the daemon's timeouts are. A process starved of CPU
-// does not jump: one run_once() simulates at most kMaxSolvesPerPass
-// equilibrium intervals, so simulated time then runs slower than
-// time_scale (a slower robot, its pose stamps too) and the work of a pass
-// stays bounded. Not
-// thread-safe: one thread calls run_once()/run().
+// clock (drive speeds, settling). A process starved of CPU does not jump:
+// one run_once() simulates at most kMaxSolvesPerPass equilibrium intervals,
+// so simulated time then runs slower than time_scale (a slower robot, its
+// pose stamps too) and the work of a pass stays bounded. The robot's clock
+// is that simulated time divided by time_scale: the monotonic clock while
+// the process keeps up, slower while it is starved. The devices' heartbeats,
+// PDO event timers, heartbeat consumers and the pose rate run on it, and a
+// daemon given it (cdpr-calibd --sim-clock <dir>/clock, or clock() in one
+// process) counts its timeouts on it: a robot starved of CPU is a slower
+// robot, not a silent node, so a test's verdict does not depend on how
+// loaded the machine is. Not thread-safe: one thread calls
+// run_once()/run(); clock() may be read from any thread.
 
 #include <array>
 #include <atomic>
@@ -37,6 +44,7 @@
 #include <vector>
 
 #include "drivers/clock/monotonic_clock.h"
+#include "drivers/clock/shared_clock.h"
 #include "sim/dataset.h"
 #include "sim/presets.h"
 #include "sim/rng.h"
@@ -97,6 +105,8 @@ class VirtualRobot {
   // (beyond kMaxSolvesPerPass intervals a pass): how much slower than its
   // time scale this robot ran.
   double robot_time_lost_s() const;
+  // The robot's clock (above), readable from any thread, also as <dir>/clock.
+  const hal::Clock& clock() const { return *robot_clock_; }
 
   std::string can_endpoint() const { return "unix:" + options_.dir + "/can.sock"; }
   std::string pose_endpoint() const { return "unix:" + options_.dir + "/pose.sock"; }
@@ -124,6 +134,8 @@ class VirtualRobot {
   VirtualRobot(const VirtualRobotOptions& options, sim::SimulatedDataset data);
   // The longest step advance() takes: the physics' equilibrium interval.
   double longest_step_s() const;
+  // The robot's clock now: the simulated time run so far, divided by time_scale.
+  hal::TimeUs robot_clock_us() const;
   void publish(hal::TimeUs now_us);
   void on_can_bytes(int client, std::string_view bytes);
   void publish_pose(hal::TimeUs now_us);
@@ -135,6 +147,7 @@ class VirtualRobot {
   VirtualRobotOptions options_;
   sim::SimulatedDataset data_;
   drivers::MonotonicClock clock_;
+  std::unique_ptr<drivers::SharedClock> robot_clock_;
   sim::Rng noise_;
   std::unique_ptr<RobotPhysics> physics_;
   std::unique_ptr<CanopenNodes> nodes_;
