@@ -107,20 +107,6 @@ void add_waypoint_progress(const calibration::CalibrationStatus& status, hal::Ti
 
 }  // namespace
 
-std::string format_error_response(std::string_view reason) {
-  Json json;
-  json["ok"] = false;
-  json["error"] = std::string(reason);
-  return line(json);
-}
-
-std::string format_ok_response(std::string_view message) {
-  Json json;
-  json["ok"] = true;
-  json["message"] = std::string(message);
-  return line(json);
-}
-
 std::string format_status_response(const calibration::CalibrationStatus& status, hal::TimeUs now_us,
                                    const std::optional<RefitStatus>& refit) {
   Json json;

@@ -49,14 +49,13 @@
 
 #include "hal/clock.h"
 #include "src/calibration/calibration_state.h"
+#include "src/control/protocol_answer.h"
 #include "src/control/refit_service.h"
 #include "src/store/calibration_store.h"
 #include "src/store/run_history.h"
 
 namespace cdpr::control {
 
-std::string format_error_response(std::string_view reason);
-std::string format_ok_response(std::string_view message);
 std::string format_status_response(const calibration::CalibrationStatus& status, hal::TimeUs now_us,
                                    const std::optional<RefitStatus>& refit = std::nullopt);
 std::string format_show_response(const std::optional<store::CurrentCalibration>& current,

@@ -16,7 +16,7 @@
 #include "calibctl/control_client.h"
 #include "calibctl/json_value.h"
 #include "calibctl/render.h"
-#include "src/control/control_response.h"
+#include "src/control/protocol_answer.h"
 #include "version/version.h"
 
 namespace {
