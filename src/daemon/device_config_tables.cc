@@ -1,6 +1,6 @@
 #include "src/daemon/device_config_tables.h"
 
-#include "src/daemon/load_cell_presets.h"
+#include "drivers/modbus/load_cell_presets.h"
 
 namespace cdpr::daemon {
 namespace {
@@ -12,6 +12,8 @@ using drivers::modbus::ByteOrder;
 using drivers::modbus::ForceUnit;
 using drivers::modbus::RegisterKind;
 using drivers::modbus::ValueType;
+using drivers::modbus::load_cell_preset;
+using drivers::modbus::load_cell_preset_names;
 constexpr IntRange kNodeId{1, 127};
 constexpr IntRange kUnsigned32{0, 0xFFFFFFFFll, true};
 constexpr IntRange kRegister{0, 65535};

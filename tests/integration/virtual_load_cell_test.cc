@@ -22,7 +22,7 @@
 
 #include "drivers/clock/monotonic_clock.h"
 #include "drivers/modbus/modbus_load_cell.h"
-#include "src/daemon/load_cell_presets.h"
+#include "drivers/modbus/load_cell_presets.h"
 #include "virtual-robot/modbus_rtu_server.h"
 #include "virtual-robot/modbus_tcp_server.h"
 
@@ -90,7 +90,7 @@ drivers::modbus::ModbusLoadCellConfig driver_config(const std::string& endpoint,
   drivers::modbus::ModbusLoadCellConfig c;
   c.endpoint = endpoint;
   c.slave_id = unit;
-  c.map = *daemon::load_cell_preset(to_string(model));
+  c.map = *drivers::modbus::load_cell_preset(to_string(model));
   if (model != LoadCellModel::kLegacyFloat32) c.map.decimals = kShownDecimals;
   c.response_timeout_us = 100'000;
   c.retries = 0;
@@ -153,10 +153,24 @@ TEST_P(EachTransport, RefusesWritesAndReadsOutsideItsMap) {
   modbus_free(ctx);
 }
 
+// The daemon's presets and the virtual transmitters are one list by name:
+// a preset without a virtual counterpart would go untested, a virtual
+// model without a preset could not be configured.
+TEST(VirtualLoadCell, EveryPresetHasAVirtualTransmitterAndEveryTransmitterAPreset) {
+  for (const drivers::modbus::LoadCellPreset& preset : drivers::modbus::load_cell_presets()) {
+    EXPECT_TRUE(parse_load_cell_model(preset.name)) << preset.name << " has no model in load_cell_models.cc";
+  }
+  for (const LoadCellModel model : all_load_cell_models()) {
+    EXPECT_TRUE(drivers::modbus::load_cell_preset(to_string(model))) << to_string(model) << " has no preset";
+  }
+}
+
 TEST_P(EachTransport, EveryVendorMapReadsRightThroughItsPreset) {
-  for (const LoadCellModel model :
-       {LoadCellModel::kLegacyFloat32, LoadCellModel::kFlintecFt11, LoadCellModel::kLaumasTlu}) {
-    SCOPED_TRACE(to_string(model));
+  for (const drivers::modbus::LoadCellPreset& preset : drivers::modbus::load_cell_presets()) {
+    SCOPED_TRACE(preset.name);
+    const std::optional<LoadCellModel> parsed = parse_load_cell_model(preset.name);
+    ASSERT_TRUE(parsed);
+    const LoadCellModel model = *parsed;
     // GIVEN a cell of this model and the daemon's driver set up from the model's preset
     LoadCellServerOptions options;
     options.model = model;

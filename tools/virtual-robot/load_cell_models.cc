@@ -58,8 +58,14 @@ void write_tlu(double tension_n, bool stable, bool error, RegisterTable& table) 
 
 }  // namespace
 
+const std::array<LoadCellModel, 3>& all_load_cell_models() {
+  static const std::array<LoadCellModel, 3> models = {LoadCellModel::kLegacyFloat32, LoadCellModel::kFlintecFt11,
+                                                      LoadCellModel::kLaumasTlu};
+  return models;
+}
+
 std::optional<LoadCellModel> parse_load_cell_model(std::string_view name) {
-  for (const LoadCellModel model : {LoadCellModel::kLegacyFloat32, LoadCellModel::kFlintecFt11, LoadCellModel::kLaumasTlu}) {
+  for (const LoadCellModel model : all_load_cell_models()) {
     if (name == to_string(model)) return model;
   }
   return std::nullopt;

@@ -33,6 +33,9 @@ constexpr int kLoadCellTableSize = 32;  // holding registers 0..31 exist
 constexpr int kShownDecimals = 2;       // indicator resolution 0.01 kg
 using RegisterTable = std::array<std::uint16_t, kLoadCellTableSize>;
 
+// Every model, in the order of the daemon's presets (each has one of the
+// same name: drivers/modbus/load_cell_presets.h).
+const std::array<LoadCellModel, 3>& all_load_cell_models();
 std::optional<LoadCellModel> parse_load_cell_model(std::string_view name);
 std::string to_string(LoadCellModel model);
 

@@ -17,7 +17,7 @@
 #include <gtest/gtest.h>
 
 #include "src/daemon/daemon_config.h"
-#include "src/daemon/load_cell_presets.h"
+#include "drivers/modbus/load_cell_presets.h"
 
 namespace cdpr::daemon {
 namespace {
@@ -81,7 +81,7 @@ TEST(ConfigTable, TheRegisterMapDefaultsAreTheDefaultPresets) {
   // GIVEN the defaults, and the defaults with the default preset's map put in
   const DaemonConfig defaults = default_daemon_config();
   DaemonConfig preset = defaults;
-  preset.load_cell.map = *load_cell_preset(defaults.load_cell.preset);
+  preset.load_cell.map = *drivers::modbus::load_cell_preset(defaults.load_cell.preset);
   // WHEN shown THEN they are the same
   EXPECT_EQ(daemon_config_values(preset), daemon_config_values(defaults));
 }

@@ -1,12 +1,7 @@
-#include "src/daemon/load_cell_presets.h"
+#include "drivers/modbus/load_cell_presets.h"
 
-namespace cdpr::daemon {
+namespace cdpr::drivers::modbus {
 namespace {
-
-using drivers::modbus::ByteOrder;
-using drivers::modbus::ForceUnit;
-using drivers::modbus::LoadCellMap;
-using drivers::modbus::ValueType;
 
 // The map this daemon always read (and the virtual robot's default):
 // float32 newtons at 0-1, status at 2 with bit 0 stable and bit 1 error.
@@ -57,16 +52,26 @@ LoadCellMap laumas_tlu() {
 
 }  // namespace
 
-const std::vector<std::string_view>& load_cell_preset_names() {
-  static const std::vector<std::string_view> names = {"legacy-float32", "flintec-ft-11", "laumas-tlu"};
+const std::vector<LoadCellPreset>& load_cell_presets() {
+  static const std::vector<LoadCellPreset> presets = {
+      {"legacy-float32", "the map this daemon always read", legacy_float32()},
+      {"flintec-ft-11", "Flintec FT-11 manual p. 42 (Modbus RTU appendix)", flintec_ft11()},
+      {"laumas-tlu", "Laumas TLU manual p. 30; LCB p. 3; WTS p. 46", laumas_tlu()},
+  };
+  return presets;
+}
+
+std::vector<std::string_view> load_cell_preset_names() {
+  std::vector<std::string_view> names;
+  for (const LoadCellPreset& preset : load_cell_presets()) names.push_back(preset.name);
   return names;
 }
 
 std::optional<LoadCellMap> load_cell_preset(std::string_view name) {
-  if (name == "legacy-float32") return legacy_float32();
-  if (name == "flintec-ft-11") return flintec_ft11();
-  if (name == "laumas-tlu") return laumas_tlu();
+  for (const LoadCellPreset& preset : load_cell_presets()) {
+    if (preset.name == name) return preset.map;
+  }
   return std::nullopt;
 }
 
-}  // namespace cdpr::daemon
+}  // namespace cdpr::drivers::modbus
