@@ -1,6 +1,6 @@
 #!/bin/sh
 # Measures the robust calibration's acceptance figures on simulated data
-# (tools/robust-acceptance.md has the measured tables):
+# (docs/measurements/robust-acceptance.md has the measured tables):
 #   1. gross errors: pulley error at 0/5/10/20 % rows with a 0.5-2 m encoder
 #      error (+ 5 % load-cell spikes of 50-500 N at 5-20 %), large/35 and
 #      large/9 (10 m off), small/8 (1 m off); recall, clean rows rejected,
