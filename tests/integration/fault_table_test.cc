@@ -110,25 +110,28 @@ TEST_P(FaultTable, TheRunStopsSafelyAndTheDaemonStaysResponsive) {
   // WHEN a run is moving the winches towards its second waypoint
   std::this_thread::sleep_for(std::chrono::seconds(1));
   ASSERT_TRUE(rig.ask("start")["ok"].boolean());
-  const auto give_up = Clock::now() + slowed(std::chrono::seconds(60));
+  // Times are the robot's (robot_time.h): what the daemon and the drives
+  // count, whatever share of the CPU the robot's thread got.
+  const hal::Clock& robot_clock = rig.robot->clock();
+  const RobotDeadline give_up(robot_clock, slowed(std::chrono::seconds(60)));
   do {
     times.add(timed_status(rig, status));
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   } while (!(status["state"].string() == "move" && status["waypoint"].integer() >= 2) &&
-           status["running"].boolean() && Clock::now() < give_up);
+           status["running"].boolean() && !give_up.passed());
   ASSERT_EQ(status["state"].string(), "move") << status["reason"].string();
   // AND the device fails while the winches move (the move starts once its
   // profiles are written; if it has not within 5 s, the fault comes anyway)
   bool moving = false;
-  const auto move_give_up = Clock::now() + slowed(std::chrono::seconds(5));
-  while (!moving && Clock::now() < move_give_up) {
+  const RobotDeadline move_give_up(robot_clock, slowed(std::chrono::seconds(5)));
+  while (!moving && !move_give_up.passed()) {
     std::array<double, kCableCount> before_m{};
     for (int i = 0; i < kCableCount; ++i) before_m[i] = rig.robot->payout_snapshot_m(i);
     times.add(timed_status(rig, status));
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     for (int i = 0; i < kCableCount; ++i) moving = moving || rig.robot->payout_snapshot_m(i) != before_m[i];
   }
-  const auto failed_at = Clock::now();
+  const hal::TimeUs failed_at_us = robot_clock.now_us();
   if (scenario.device == Device::kWinches) {
     rig.robot->set_can_fault(scenario.fault);
   } else if (scenario.device == Device::kPose) {
@@ -140,21 +143,22 @@ TEST_P(FaultTable, TheRunStopsSafelyAndTheDaemonStaysResponsive) {
   do {
     times.add(timed_status(rig, status));
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  } while (status["running"].boolean() && Clock::now() < failed_at + slowed(std::chrono::seconds(30)));
-  const double time_to_fault_ms = std::chrono::duration<double, std::milli>(Clock::now() - failed_at).count();
+  } while (status["running"].boolean() && robot_ms_since(robot_clock, failed_at_us) < slowed_ms(30'000.0));
+  const double time_to_fault_ms = robot_ms_since(robot_clock, failed_at_us);
   ASSERT_EQ(status["state"].string(), "failed");
   // AND the winches stand still from then on (and status keeps answering).
   // The master quick-stops them itself when it can still reach them; when
   // the bus is gone it cannot, and the drives stop on their own once the
   // master's heartbeat has been missing for their consumer time, then brake.
-  const auto still_by = scenario.device == Device::kWinches
-                            ? failed_at + std::chrono::microseconds(kWinchHeartbeatUs) + kQuickStopBraking
-                            : Clock::now() + slowed(std::chrono::milliseconds(200));
-  std::this_thread::sleep_until(std::max(still_by, Clock::now()));
+  const hal::TimeUs still_by_us =
+      scenario.device == Device::kWinches
+          ? failed_at_us + kWinchHeartbeatUs + std::chrono::duration_cast<std::chrono::microseconds>(kQuickStopBraking).count()
+          : robot_clock.now_us() + slowed_us(200'000);
+  RobotDeadline(robot_clock, std::chrono::microseconds(still_by_us - robot_clock.now_us())).wait();
   std::array<double, kCableCount> payout_m{};
   for (int i = 0; i < kCableCount; ++i) payout_m[i] = rig.robot->payout_snapshot_m(i);
-  const auto watch_until = Clock::now() + slowed(std::chrono::seconds(1));
-  while (Clock::now() < watch_until) {
+  const RobotDeadline watch_until(robot_clock, slowed(std::chrono::seconds(1)));
+  while (!watch_until.passed()) {
     times.add(timed_status(rig, status));
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }

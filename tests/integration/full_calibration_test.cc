@@ -37,12 +37,12 @@ TEST(FullCalibration, LargeRobotWith35WaypointsFindsTheAnchorsWithin10cm) {
   std::this_thread::sleep_for(std::chrono::seconds(1));
   StatusPoller poller(rig.config.control_socket, std::chrono::milliseconds(20));
   ASSERT_TRUE(rig.ask("start")["ok"].boolean());
-  const auto deadline = std::chrono::steady_clock::now() + slowed(std::chrono::minutes(5));
+  const RobotDeadline deadline(rig.robot->clock(), slowed(std::chrono::minutes(5)));
   calibctl::JsonValue status;
   do {
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     status = rig.ask("status");
-  } while (status["running"].boolean() && std::chrono::steady_clock::now() < deadline);
+  } while (status["running"].boolean() && !deadline.passed());
   poller.stop();
   rig.loop->wait_for_history();  // the run's data and the model check after its solve
   rig.stop_daemon();
@@ -121,7 +121,7 @@ TEST(FullCalibration, LargeRobotSequentialReachesTheTargetWithFewerWaypoints) {
   // WHEN the operator starts a calibration and it runs to its end
   std::this_thread::sleep_for(std::chrono::seconds(1));
   ASSERT_TRUE(rig.ask("start")["ok"].boolean());
-  const auto deadline = std::chrono::steady_clock::now() + slowed(std::chrono::minutes(5));
+  const RobotDeadline deadline(rig.robot->clock(), slowed(std::chrono::minutes(5)));
   calibctl::JsonValue status;
   bool saw_sigma = false, saw_time_left = false;
   do {
@@ -129,7 +129,7 @@ TEST(FullCalibration, LargeRobotSequentialReachesTheTargetWithFewerWaypoints) {
     status = rig.ask("status");
     saw_sigma = saw_sigma || !status["sigma"].is_null();
     saw_time_left = saw_time_left || !status["time_left_s"].is_null();
-  } while (status["running"].boolean() && std::chrono::steady_clock::now() < deadline);
+  } while (status["running"].boolean() && !deadline.passed());
   rig.loop->wait_for_history();
   rig.stop_daemon();
   rig.keep_dir = true;

@@ -51,7 +51,7 @@ std::string summary_value(const std::string& output, const std::string& key) {
 // status "run" once its model check is done (or as it is after 120 s).
 calibctl::JsonValue model_check_of_last_run(const VirtualRobotProcess& rig) {
   calibctl::JsonValue run;
-  wait_until(
+  rig.wait_until_robot(
       [&] {
         run = rig.ask("status")["run"];
         return !run["diagnosis"].string().empty();

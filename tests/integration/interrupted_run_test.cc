@@ -23,7 +23,7 @@ TEST(InterruptedRun, ADaemonKilledMidRunIsReportedAfterRestartUntilTheNextStart)
   std::this_thread::sleep_for(1s);  // the CANopen nodes' first heartbeats
   ASSERT_TRUE(rig.ask("start")["ok"].boolean()) << first->log();
   calibctl::JsonValue status;
-  ASSERT_TRUE(wait_until(
+  ASSERT_TRUE(rig.wait_until_robot(
       [&] {
         status = rig.ask("status");
         return status["waypoint"].integer() >= 2 || !status["running"].boolean();

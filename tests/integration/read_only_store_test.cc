@@ -82,7 +82,8 @@ TEST(ReadOnlyStore, TurningReadOnlyMidRunKeepsTheFitAndCommitRetriesIt) {
   ASSERT_TRUE(wait_until([&] { return rig.answers(); }, slowed(30s))) << daemon->log();
   std::this_thread::sleep_for(1s);
   ASSERT_TRUE(rig.ask("start")["ok"].boolean());
-  ASSERT_TRUE(wait_until([&] { return rig.ask("status")["waypoint"].integer() >= 2; }, slowed(60s))) << daemon->log();
+  ASSERT_TRUE(rig.wait_until_robot([&] { return rig.ask("status")["waypoint"].integer() >= 2; }, slowed(60s)))
+      << daemon->log();
   // WHEN the history directory becomes read-only after preflight
   ASSERT_TRUE(remount(daemon->pid(), history, "ro"));
   const calibctl::JsonValue status = rig.wait_for_end(slowed(240s));

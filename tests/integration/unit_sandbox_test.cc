@@ -98,7 +98,7 @@ class SandboxedDaemon {
         "--ro-bind", dir + "/passwd", "/etc/passwd", "--ro-bind", dir + "/group", "/etc/group",
         "--info-fd", std::to_string(info[1]), "--",
         CDPR_BINARY_DIR "/tests/sandbox/unit-sandbox-exec", CDPR_BINARY_DIR "/tests/sandbox/cdpr-calibd.sandbox",
-        CDPR_BINARY_DIR "/src/cdpr-calibd", "--config", config_path};
+        CDPR_BINARY_DIR "/src/cdpr-calibd", "--config", config_path, "--sim-clock", dir + "/robot/clock"};
     std::vector<char*> argv;  // made before fork(): the child of a threaded process must not allocate
     for (std::string& arg : args) argv.push_back(arg.data());
     argv.push_back(nullptr);
@@ -247,12 +247,12 @@ TEST(UnitSandbox, FullCalibrationOfTheVirtualRobotWithTheDaemonInsideTheUnitsSan
   // WHEN the operator starts a calibration (once the nodes' heartbeats are in) and it runs to its end
   std::this_thread::sleep_for(std::chrono::seconds(1));
   ASSERT_TRUE(ask_daemon(rig.socket, "start")["ok"].boolean()) << rig.log();
-  const auto deadline = std::chrono::steady_clock::now() + slowed(std::chrono::minutes(5));
+  const RobotDeadline deadline(rig.robot->clock(), slowed(std::chrono::minutes(5)));
   calibctl::JsonValue status;
   do {
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     status = ask_daemon(rig.socket, "status");
-  } while (status["running"].boolean() && std::chrono::steady_clock::now() < deadline);
+  } while (status["running"].boolean() && !deadline.passed());
   rig.keep_dir = true;  // for diagnosis, unless everything below passes
 
   // THEN it committed a calibration from 35 waypoints into its state directory

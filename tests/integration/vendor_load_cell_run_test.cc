@@ -41,11 +41,11 @@ TEST_P(VendorLoadCellRun, SamplesThePredictedTensions) {
   std::this_thread::sleep_for(std::chrono::seconds(1));
   ASSERT_TRUE(rig.ask("start")["ok"].boolean());
   calibctl::JsonValue status;
-  const auto give_up = Clock::now() + slowed(std::chrono::seconds(90));
+  const RobotDeadline give_up(rig.robot->clock(), slowed(std::chrono::seconds(90)));
   do {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     status = rig.ask("status");
-  } while (status["samples"].integer() < 3 && status["running"].boolean() && Clock::now() < give_up);
+  } while (status["samples"].integer() < 3 && status["running"].boolean() && !give_up.passed());
   ASSERT_GE(status["samples"].integer(), 3) << status["state"].string() << ": " << status["reason"].string();
   rig.ask("abort");
   rig.stop_daemon();
@@ -72,11 +72,11 @@ TEST_P(VendorLoadCellRun, AMissingDecimalPointStopsTheRunOnTheTensionLimit) {
   std::this_thread::sleep_for(std::chrono::seconds(1));
   ASSERT_TRUE(rig.ask("start")["ok"].boolean());
   calibctl::JsonValue status;
-  const auto give_up = Clock::now() + slowed(std::chrono::seconds(30));
+  const RobotDeadline give_up(rig.robot->clock(), slowed(std::chrono::seconds(30)));
   do {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
     status = rig.ask("status");
-  } while (status["running"].boolean() && Clock::now() < give_up);
+  } while (status["running"].boolean() && !give_up.passed());
   // THEN it fails on the tension limit, before the first waypoint
   EXPECT_EQ(status["state"].string(), "failed");
   EXPECT_NE(status["reason"].string().find("tension out of limits"), std::string::npos) << status["reason"].string();

@@ -20,6 +20,8 @@
 #include "calibctl/control_client.h"
 #include "calibctl/json_value.h"
 #include "daemon_process.h"
+#include "drivers/clock/shared_clock.h"
+#include "robot_time.h"
 #include "slowdown.h"
 
 namespace cdpr::integration {
@@ -45,6 +47,12 @@ class VirtualRobotProcess {
     robot_ = std::make_unique<ChildProcess>(robot_argv, dir + "/robot.log");
     if (!wait_until([&] { return std::filesystem::exists(dir + "/robot/ready"); }, slowed(60s))) {
       ADD_FAILURE() << "the virtual robot did not start: " << robot_->log();
+    }
+    hal::Status opened;
+    robot_clock_ = drivers::SharedClock::open(dir + "/robot/clock", opened);
+    if (!robot_clock_) {
+      ADD_FAILURE() << "the virtual robot's clock: " << opened.to_string();
+      robot_clock_ = drivers::SharedClock::in_memory(0);  // still a clock: waits on it end at once
     }
     config = dir + "/cdpr-calibd.toml";
     const bool small = preset == "small";
@@ -93,10 +101,17 @@ class VirtualRobotProcess {
     return value ? *value : calibctl::JsonValue{};
   }
   bool answers() const { return ask("status")["ok"].boolean(); }
-  // The status once the run has ended (or the last one seen after `timeout`).
+  // The virtual robot's clock (its <endpoints>/clock), which the daemons run on.
+  const hal::Clock& robot_clock() const { return *robot_clock_; }
+  // wait_until() in the robot's time (robot_time.h).
+  template <class Predicate>
+  bool wait_until_robot(Predicate ready, std::chrono::milliseconds timeout) const {
+    return integration::wait_until_robot(*robot_clock_, ready, timeout);
+  }
+  // The status once the run has ended (or the last one seen after `timeout` of the robot's time).
   calibctl::JsonValue wait_for_end(std::chrono::seconds timeout) const {
     calibctl::JsonValue status;
-    wait_until(
+    wait_until_robot(
         [&] {
           status = ask("status");
           return status["ok"].boolean() && !status["running"].boolean();
@@ -118,6 +133,7 @@ class VirtualRobotProcess {
   }
 
   std::unique_ptr<ChildProcess> robot_;
+  std::unique_ptr<drivers::SharedClock> robot_clock_;
 };
 
 }  // namespace cdpr::integration

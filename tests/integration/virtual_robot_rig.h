@@ -27,6 +27,7 @@
 #include "src/calibration/waypoint_planner.h"
 #include "src/daemon/daemon_loop.h"
 #include "drivers/modbus/load_cell_presets.h"
+#include "robot_time.h"
 #include "slowdown.h"
 #include "virtual-robot/virtual_robot.h"
 
