@@ -40,7 +40,7 @@ FUZZ_BUILD   ?= $(BUILD)-fuzz
 FUZZ_SECONDS ?= 600
 FUZZ_TARGETS ?=
 
-.PHONY: all deps build-deps bench-deps configure check test sanitize fuzz demo demo-offline bench install deb clean
+.PHONY: all deps build-deps bench-deps configure check test sanitize fuzz demo demo-offline bench install deb docs clean
 
 all: configure
 	cmake --build $(BUILD) -j $(JOBS)
@@ -105,6 +105,13 @@ bench: bench-deps configure
 	cmake -S . -B $(BUILD) -DCDPR_BENCH=ON
 	cmake --build $(BUILD) -j $(JOBS) --target cdpr-bench
 	$(BUILD)/tools/cdpr-bench
+
+# The generated docs, rewritten from the code that owns them: the key
+# listing of docs/configuration.md from the key tables (a unit test holds the
+# page to the tables and says when to run this).
+docs: configure
+	cmake --build $(BUILD) -j $(JOBS) --target daemon_tests
+	CDPR_UPDATE_DOCS=1 $(BUILD)/tests/daemon_tests --gtest_filter='ConfigTable.TheDocsPage*'
 
 # The unit installed with the daemon names it under $(PREFIX) (systemd/CMakeLists.txt).
 install: all

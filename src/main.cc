@@ -107,6 +107,14 @@ int main(int argc, char** argv) {
     log_line("configuration: " + config.error().message());
     return 1;
   }
+  if (const auto problem = daemon::check_config_paths(*config)) {
+    log_line("configuration: " + problem->message());
+    return 1;
+  }
+  for (const daemon::UnsafeValue& unsafe : config->unsafe_accepted) {
+    log_line("configuration: " + config->source + ":" + std::to_string(unsafe.line) + ": " + unsafe.key + ": " +
+             unsafe.reason + " (accepted: unsafe_ok)");
+  }
   const auto robot = formats::read_robot_toml(config->robot_path);
   if (!robot) {
     log_line("robot: " + robot.error().message());

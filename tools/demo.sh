@@ -45,10 +45,12 @@ start_virtual_robot "$work" "$build" 20 "${DEMO_SEED:-7}" ${DEMO_EFFECTS:-}
 # The virtual robot's CANopen nodes and pose stream share one thread with its
 # physics, whose equilibrium solve can hold them past the shipped 500 ms
 # (a hard move, a busy machine); a real drive or tracker does not wait for
-# physics: hence the heartbeat and pose_stale_ms. The daemon runs on the
-# robot's clock (--sim-clock), so a robot starved of CPU by a busy machine
-# is a slower robot to it, not a silent node.
+# physics: hence the heartbeat and pose_stale_ms, beyond what a robot should
+# run with, so acknowledged in unsafe_ok. The daemon runs on the robot's
+# clock (--sim-clock), so a robot starved of CPU by a busy machine is a
+# slower robot to it, not a silent node.
 write_daemon_config "$work" \
+  top='unsafe_ok = ["winches.heartbeat_timeout_ms", "limits.pose_stale_ms"]' \
   winches="max_speed_mps = 100.0
 heartbeat_timeout_ms = 2000" \
   limits="settle_timeout_s = 15.0

@@ -39,7 +39,8 @@ start_virtual_robot() {
 
 # Writes $1/cdpr-calibd.toml: the daemon against the robot start_virtual_robot
 # started in $1, state in $1/state, control socket $1/control. Each further
-# argument SECTION=LINES adds TOML lines to that section ("drive" is
+# argument SECTION=LINES adds TOML lines to that section ("top" is the top
+# level, before the first table; "drive" is
 # [winches.drive]); the keys are those of systemd/cdpr-calibd.toml.
 #   write_daemon_config WORK [winches=...] [load_cell=...] [limits=...] ...
 write_daemon_config() {
@@ -51,6 +52,7 @@ write_daemon_config() {
   cat >"$work/cdpr-calibd.toml" <<CONFIG
 # cdpr-calibd against the virtual robot (keys: systemd/cdpr-calibd.toml)
 robot = "$work/robot/robot.toml"
+${keys[top]:-}
 [store]
 state_dir = "$work/state"
 [control]

@@ -59,17 +59,19 @@ enum class WaypointOrder {
   kSelection,
 };
 
+// The defaults are the daemon's [waypoints] defaults (a test in
+// tests/src/daemon holds the two to each other): the large robot's band.
 struct PlannerOptions {
   int waypoint_count = 35;
-  double margin_m = 5.0;  // inset from the anchors' xy footprint [m]
-  double z_min_m = 5.0;   // world z band of the platform origin [m]
-  double z_max_m = 30.0;
+  double margin_m = 20.0;  // inset from the anchors' xy footprint [m]
+  double z_min_m = 5.0;    // world z band of the platform origin [m]
+  double z_max_m = 35.0;
   int grid_xy = 8;        // candidates per horizontal axis
   int grid_z = 4;         // candidates along z
   double jitter_fraction = 0.3;  // of the grid step, in [0, 0.5)
   std::uint32_t seed = 1;
   double min_tension_n = 20.0;   // every cable [N]
-  double max_tension_n = 5000.0;
+  double max_tension_n = 3000.0;
   double min_payout_m = -1e9;    // winch travel limits in encoder units [m]
   double max_payout_m = 1e9;
   double max_sag_excess = 0.02;  // (arc length - chord) / chord, every cable

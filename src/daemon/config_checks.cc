@@ -1,9 +1,13 @@
 #include "src/daemon/config_checks.h"
 
+#include <sys/stat.h>
 #include <sys/un.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
+#include <cstring>
 #include <string_view>
 
 #include "src/calibration/message_text.h"
@@ -33,6 +37,21 @@ std::optional<FormatError> ordered(const DaemonConfig& config, std::string_view 
                  std::string(low_key) + " (" + significant(low) + " " + std::string(unit) + ") must be below " +
                      std::string(high_key) + " (" + significant(high) + " " + std::string(unit) + ")");
 }
+
+// `value` must be at least `factor` x `other`; blamed as `ordered` does.
+std::optional<FormatError> at_least(const DaemonConfig& config, std::string_view key, double value, double factor,
+                                    std::string_view other_key, double other, std::string_view unit,
+                                    std::string_view why) {
+  if (value >= factor * other) return std::nullopt;
+  const std::string_view blamed = line_of(config, other_key) > line_of(config, key) ? other_key : key;
+  const std::string times = factor == 1.0 ? "" : significant(factor) + " x ";
+  return problem(config, blamed,
+                 std::string(key) + " (" + significant(value) + " " + std::string(unit) + ") must be at least " +
+                     times + std::string(other_key) + " (" + significant(other) + " " + std::string(unit) +
+                     "): " + std::string(why));
+}
+
+double ms(hal::TimeUs us) { return 1e-3 * static_cast<double>(us); }
 
 bool is_port(std::string_view digits) {
   int port = 0;
@@ -161,13 +180,6 @@ std::optional<FormatError> check_counts_and_times(const DaemonConfig& c) {
                        significant(1e-6 * static_cast<double>(o.equilibrium.window_us)) +
                        " s): every waypoint would be skipped");
   }
-  // The drives watch the daemon's heartbeat: a window no longer than its
-  // period stops them between two heartbeats.
-  if (auto p = ordered(c, "winches.master_heartbeat_ms", 1e-3 * static_cast<double>(c.winches.master_heartbeat_us),
-                       "winches.drive.consumer_heartbeat_ms",
-                       1e-3 * static_cast<double>(c.winches.drive.consumer_heartbeat_us), "ms")) {
-    return p;
-  }
   if (o.monitor.pose_stale_us <= c.loop_period_us) {
     return problem(c, "limits.pose_stale_ms",
                    "must be longer than loop.period_ms (" +
@@ -176,12 +188,53 @@ std::optional<FormatError> check_counts_and_times(const DaemonConfig& c) {
   return std::nullopt;
 }
 
+// CiA 301 heartbeat consumers: a window of 1.5 producer periods (the
+// docs' rule) takes one late heartbeat without declaring the node lost.
+std::optional<FormatError> check_heartbeats(const DaemonConfig& c) {
+  const WinchesConfig& w = c.winches;
+  if (auto p = at_least(c, "winches.drive.consumer_heartbeat_ms", ms(w.drive.consumer_heartbeat_us), 1.5,
+                        "winches.master_heartbeat_ms", ms(w.master_heartbeat_us), "ms",
+                        "the drives would stop between two of the daemon's heartbeats")) {
+    return p;
+  }
+  if (auto p = at_least(c, "winches.heartbeat_timeout_ms", ms(w.heartbeat_timeout_us), 1.5,
+                        "winches.drive.heartbeat_producer_ms", ms(w.drive.heartbeat_producer_us), "ms",
+                        "a drive would be lost between two of its heartbeats")) {
+    return p;
+  }
+  return at_least(c, "winches.heartbeat_timeout_ms", ms(w.heartbeat_timeout_us), 1.5,
+                  "winches.encoder.heartbeat_producer_ms", ms(w.encoder.heartbeat_producer_us), "ms",
+                  "an encoder would be lost between two of its heartbeats");
+}
+
+// The stop ramps and speeds of the drives against each other and the jump check.
+std::optional<FormatError> check_motion(const DaemonConfig& c) {
+  const drivers::can::DriveDescription& d = c.winches.drive;
+  if (auto p = at_least(c, "winches.drive.quick_stop_deceleration_mps2", d.quick_stop_deceleration_mps2, 1.0,
+                        "winches.drive.profile_deceleration_mps2", d.profile_deceleration_mps2, "m/s^2",
+                        "a quick stop (abort, lost heartbeat) must not stop later than a planned stop")) {
+    return p;
+  }
+  if (d.profile_velocity_mps >= c.winches.max_speed_mps) {
+    return problem(c, line_of(c, "winches.drive.profile_velocity_mps") > line_of(c, "winches.max_speed_mps")
+                          ? "winches.drive.profile_velocity_mps"
+                          : "winches.max_speed_mps",
+                   "winches.drive.profile_velocity_mps (" + significant(d.profile_velocity_mps) +
+                       " m/s) must be below winches.max_speed_mps (" + significant(c.winches.max_speed_mps) +
+                       " m/s): the encoder jump check would stop every move");
+  }
+  return std::nullopt;
+}
+
+
 }  // namespace
 
 std::optional<FormatError> check_cross_keys(const DaemonConfig& config) {
   if (auto p = check_endpoints(config)) return p;
   if (auto p = check_load_cell(config)) return p;
   if (auto p = check_limits(config)) return p;
+  if (auto p = check_heartbeats(config)) return p;
+  if (auto p = check_motion(config)) return p;
   return check_counts_and_times(config);
 }
 
@@ -197,6 +250,23 @@ std::optional<FormatError> check_config_against_robot(const DaemonConfig& config
     return problem(config, "waypoints.z_max",
                    significant(w.z_max_m) + " m is not below the lowest anchor of robot " + robot.name + " (" +
                        significant(lowest_anchor_m) + " m): the platform hangs below its pulleys");
+  }
+  return std::nullopt;
+}
+
+}  // namespace cdpr::daemon
+
+namespace cdpr::daemon {
+
+std::optional<FormatError> check_config_paths(const DaemonConfig& config) {
+  struct stat info {};
+  if (stat(config.robot_path.c_str(), &info) != 0 || access(config.robot_path.c_str(), R_OK) != 0) {
+    return problem(config, "robot", "cannot read \"" + config.robot_path + "\": " + std::strerror(errno));
+  }
+  if (!S_ISREG(info.st_mode)) return problem(config, "robot", "\"" + config.robot_path + "\" is not a file");
+  const std::string& dir = config.store.state_dir;
+  if (stat(dir.c_str(), &info) == 0 && !S_ISDIR(info.st_mode)) {
+    return problem(config, "store.state_dir", "\"" + dir + "\" is not a directory");
   }
   return std::nullopt;
 }

@@ -24,14 +24,19 @@ std::string range_text(const IntRange& range) {
 std::string range_text(const NumberRange& range) {
   const bool low = std::isfinite(range.lo);
   const bool high = std::isfinite(range.hi);
-  if (range.nonzero) return "!= 0";
+  const std::string nonzero = range.nonzero ? "!= 0" : "";
   if (low && high) {
     return std::string(range.lo_open ? "(" : "[") + number_text(range.lo) + ", " + number_text(range.hi) +
-           (range.hi_open ? ")" : "]");
+           (range.hi_open ? ")" : "]") + (range.nonzero ? ", " + nonzero : "");
   }
+  if (range.nonzero) return nonzero;
   if (low) return (range.lo_open ? "> " : ">= ") + number_text(range.lo);
   if (high) return (range.hi_open ? "< " : "<= ") + number_text(range.hi);
   return "";
+}
+
+std::string range_text(const DurationRange& range) {
+  return range_text(NumberRange{range.lo, range.hi}) + (range.whole ? ", whole" : "");
 }
 
 std::string out_of_range(const std::string& range, const std::string& value) {
@@ -69,6 +74,12 @@ std::optional<std::string> KeyContext::string() const {
     return std::nullopt;
   }
   return value;
+}
+
+std::optional<std::vector<std::string>> KeyContext::strings() const {
+  std::vector<std::string> values = reader_.strings(table_, key_, path_);
+  if (reader_.failed()) return std::nullopt;
+  return values;
 }
 
 std::optional<bool> KeyContext::boolean() const {

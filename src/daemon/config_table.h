@@ -2,10 +2,10 @@
 // The rows behind cdpr-calibd.toml (daemon_config.cc holds the tables). A
 // Table is one TOML table of the file ([winches.drive], say) bound to the
 // struct its values go to; each row names one key once, with its type,
-// unit, range, default and meaning. The rows read and range-check the keys
-// (every refusal with file, line and dotted key), give the daemon its
-// defaults, and list the keys for docs/configuration.md and for the test
-// that holds the shipped example to the tables.
+// unit, range and why that range, default and meaning. The rows read and
+// range-check the keys (every refusal with file, line and dotted key), give
+// the daemon its defaults, and list the keys for docs/configuration.md and
+// for the test that holds the shipped example to the tables.
 //
 // A row's `field` is a data member pointer of the table's struct, or a
 // generic lambda `[](auto& t) -> auto& { return t.map.decimals; }` for a
@@ -54,6 +54,14 @@ inline constexpr NumberRange kNonZero{-std::numeric_limits<double>::infinity(),
 enum class TimeUnit { kMilliseconds, kSeconds };
 inline constexpr TimeUnit kMs = TimeUnit::kMilliseconds;
 
+// A duration key's allowed values, lo..hi (lo > 0) in the key's unit;
+// `whole`: a whole number of it (a CANopen object holds whole milliseconds).
+struct DurationRange {
+  double lo = 0.0;
+  double hi = 0.0;
+  bool whole = false;
+};
+
 // An integer default, or one counted up per table of an array ([[winches.winch]]: node 1, 2, 3, 4).
 struct IntDefault {
   IntDefault(std::int64_t value) : first(value) {}  // NOLINT: a plain number is the usual default
@@ -77,6 +85,7 @@ class KeyContext {
   std::optional<std::int64_t> integer(const IntRange& range) const;
   std::optional<double> number(const NumberRange& range) const;
   std::optional<std::string> string() const;  // not empty
+  std::optional<std::vector<std::string>> strings() const;
   std::optional<bool> boolean() const;
   void fail(const std::string& reason) const;
 
@@ -89,6 +98,7 @@ class KeyContext {
 
 std::string range_text(const IntRange& range);
 std::string range_text(const NumberRange& range);
+std::string range_text(const DurationRange& range);
 std::string integer_text(std::int64_t value, bool hex);
 std::string number_text(double value);
 // The message of a value outside its range: "must be in 1..127, got 300".
@@ -102,6 +112,7 @@ struct Row {
   std::function<std::string(const T&)> show;           // the value as TOML text
   std::function<std::string(const T&)> refuse;         // after read: "" or what is wrong beyond the range
   std::function<void(T&)> then;                        // after read and set_default (a preset's map)
+  std::function<std::string(const T&)> unsafe;         // after read: "" or how the value defeats a safety function
 };
 
 template <class T>
@@ -139,17 +150,39 @@ class Table {
     return *this;
   }
 
-  // A hal::TimeUs written in the unit the key's name gives, > 0.
+  // A hal::TimeUs written in the unit the key's name gives.
   template <class Field>
-  Table& duration(std::string_view name, Field field, double fallback, TimeUnit unit, std::string_view meaning) {
+  Table& duration(std::string_view name, Field field, double fallback, TimeUnit unit, DurationRange range,
+                  std::string_view meaning) {
     const double us_per_unit = unit == TimeUnit::kMilliseconds ? 1e3 : 1e6;
-    Row<T>& row = add(name, "number", unit == TimeUnit::kMilliseconds ? "ms" : "s", range_text(kPositive), meaning);
+    Row<T>& row = add(name, "number", unit == TimeUnit::kMilliseconds ? "ms" : "s", range_text(range), meaning);
     row.set_default = [field, fallback, us_per_unit](T& t, int) { std::invoke(field, t) = microseconds(fallback, us_per_unit); };
-    row.read = [field, us_per_unit](const KeyContext& key, T& t) {
-      if (const auto value = key.number(kPositive)) std::invoke(field, t) = microseconds(*value, us_per_unit);
+    row.read = [field, us_per_unit, range](const KeyContext& key, T& t) {
+      const auto value = key.number({range.lo, range.hi});
+      if (!value) return;
+      if (range.whole && *value != std::floor(*value)) {
+        return key.fail("must be a whole number, got " + number_text(*value));
+      }
+      std::invoke(field, t) = microseconds(*value, us_per_unit);
     };
     row.show = [field, us_per_unit](const T& t) {
       return number_text(static_cast<double>(std::invoke(field, t)) / us_per_unit);
+    };
+    return *this;
+  }
+
+  // An array of strings; empty by default.
+  template <class Field>
+  Table& strings(std::string_view name, Field field, std::string_view meaning) {
+    Row<T>& row = add(name, "array of strings", "", "", meaning);
+    row.set_default = [field](T& t, int) { std::invoke(field, t).clear(); };
+    row.read = [field](const KeyContext& key, T& t) {
+      if (auto value = key.strings()) std::invoke(field, t) = std::move(*value);
+    };
+    row.show = [field](const T& t) {
+      std::string text;
+      for (const std::string& item : std::invoke(field, t)) text += (text.empty() ? "" : ", ") + quoted(item);
+      return "[" + text + "]";
     };
     return *this;
   }
@@ -205,7 +238,7 @@ class Table {
     return *this;
   }
 
-  // The key `robot` alone: refused when absent.
+  // A key without a default (robot, the device endpoints): refused when absent.
   Table& required() {
     rows_.back().info.required = true;
     return *this;
@@ -215,6 +248,20 @@ class Table {
   Table& refusing(std::string range, std::function<std::string(const T&)> refuse) {
     rows_.back().info.range = std::move(range);
     rows_.back().refuse = std::move(refuse);
+    return *this;
+  }
+  // Why the last row's range is what it is: the safety function or the
+  // physical limit behind it (docs/configuration.md shows it).
+  Table& why(std::string_view reason) {
+    rows_.back().info.range_reason = std::string(reason);
+    return *this;
+  }
+  // Values of the last row's key, inside its range, that defeat a safety
+  // function: refused unless unsafe_ok lists the key. `unsafe` returns ""
+  // or what the value gives up; `when` says in the docs which values these are.
+  Table& unsafe_unless_acknowledged(std::string when, std::function<std::string(const T&)> unsafe) {
+    rows_.back().info.unsafe_when = std::move(when);
+    rows_.back().unsafe = std::move(unsafe);
     return *this;
   }
   // What setting the last row's key does besides setting its field.
@@ -230,23 +277,27 @@ class Table {
     }
   }
 
-  // Reads the keys of `table` (its unknown keys already refused) into `target`.
+  // Reads the keys of `table` (its unknown keys already refused) into
+  // `target`; a missing required key is left to the caller (it is named
+  // after the values given are checked), an unsafe value is noted in `unsafe`.
   void read(formats::TomlReader& reader, const toml::table& table, std::string_view path, T& target,
-            KeyLines& key_lines) const {
+            KeyLines& key_lines, std::vector<UnsafeValue>& unsafe) const {
     for (const Row<T>& row : rows_) {
       if (reader.failed()) return;
       const toml::node* node = table.get(row.info.name);
-      if (node == nullptr) {
-        // A required key: the reader names it missing.
-        if (row.info.required) (void)reader.string(table, row.info.name, path);
-        continue;
-      }
-      key_lines[formats::join_key(path, row.info.name)] = formats::TomlReader::line_of(*node);
+      if (node == nullptr) continue;
+      const std::string dotted = formats::join_key(path, row.info.name);
+      key_lines[dotted] = formats::TomlReader::line_of(*node);
       const KeyContext key(reader, table, path, row.info.name);
       row.read(key, target);
       if (reader.failed()) return;
       if (row.refuse) {
         if (const std::string reason = row.refuse(target); !reason.empty()) return key.fail(reason);
+      }
+      if (row.unsafe) {
+        if (std::string reason = row.unsafe(target); !reason.empty()) {
+          unsafe.push_back({dotted, formats::TomlReader::line_of(*node), std::move(reason)});
+        }
       }
       if (row.then) row.then(target);
     }
@@ -264,8 +315,12 @@ class Table {
   Row<T>& add(std::string_view name, std::string type, std::string_view unit, std::string range,
               std::string_view meaning) {
     Row<T>& row = rows_.emplace_back();
-    row.info = KeyInfo{path_, std::string(name), std::move(type), std::string(unit), std::move(range), "",
-                       std::string(meaning)};
+    row.info.table = path_;
+    row.info.name = std::string(name);
+    row.info.type = std::move(type);
+    row.info.unit = std::string(unit);
+    row.info.range = std::move(range);
+    row.info.meaning = std::string(meaning);
     return row;
   }
 

@@ -1,5 +1,6 @@
 #include "src/daemon/daemon_config.h"
 
+#include <algorithm>
 #include <optional>
 
 #include "src/daemon/config_checks.h"
@@ -38,6 +39,9 @@ Table<DaemonConfig> top_table() {
   Table<DaemonConfig> t("");
   t.string("robot", &DaemonConfig::robot_path, "", "robot.toml: nominal geometry, cable data and sensor noise")
       .required();
+  t.strings("unsafe_ok", &DaemonConfig::unsafe_ok,
+            "keys allowed a value that defeats a safety function (the Range column says which values), e.g. "
+            "[\"winches.drive.abort_connection_option\"]; the daemon names them at start");
   return t;
 }
 
@@ -46,15 +50,17 @@ Table<store::StoreOptions> store_table() {
   t.string("state_dir", &store::StoreOptions::state_dir, "/var/lib/cdpr-calib",
            "state directory: calibration.toml, history/, pending/, the run marker and the lock");
   t.integer("history_depth", &store::StoreOptions::history_depth, 10, {0, 1000}, "",
-            "previous calibrations kept besides the current one");
+            "previous calibrations kept besides the current one")
+      .why("each is a few kB; more than 1000 is a typo");
   return t;
 }
 
 Table<HistoryConfig> history_table() {
   Table<HistoryConfig> t("history");
-  t.number("budget_mb", &HistoryConfig::budget_mb, 200.0, kNonNegative, "MB",
+  t.number("budget_mb", &HistoryConfig::budget_mb, 200.0, {0.0, 1e6}, "MB",
            "every run's data is kept in history/run-*; beyond this the oldest go, never the current "
-           "calibration's run, a pending fit's nor the last run");
+           "calibration's run, a pending fit's nor the last run")
+      .why("more than 1 TB of run data is a typo");
   t.boolean("model_check", &HistoryConfig::model_check, true,
             "after each solve, check the model on the run's data (cdpr-calib diagnose) and record the verdict");
   return t;
@@ -76,29 +82,42 @@ Table<DaemonConfig> control_table() {
 
 Table<DaemonConfig> loop_table() {
   Table<DaemonConfig> t("loop");
-  t.duration("period_ms", &DaemonConfig::loop_period_us, 20, kMs,
-             "state-machine step; the watchdog is pinged every step");
+  t.duration("period_ms", &DaemonConfig::loop_period_us, 20, kMs, {1, 100},
+             "state-machine step; the watchdog is pinged every step")
+      .why("the tension and pose checks run once a step: beyond 100 ms a 2 m/s cable runs 0.2 m between two");
   return t;
 }
 
 Table<CalibratorOptions> limits_table() {
   Table<CalibratorOptions> t("limits");
-  t.number("min_tension", [](auto& o) -> auto& { return o.monitor.min_tension_n; }, 20.0, kNonNegative, "N",
-           "reference cable (load cell), checked every step while the winches may move");
-  t.number("max_tension", [](auto& o) -> auto& { return o.monitor.max_tension_n; }, 5000.0, kPositive, "N", "");
-  t.duration("pose_stale_ms", [](auto& o) -> auto& { return o.monitor.pose_stale_us; }, 500, kMs,
-             "oldest acceptable pose sample");
+  t.number("min_tension", [](auto& o) -> auto& { return o.monitor.min_tension_n; }, 20.0, {0.0, 1e5}, "N",
+           "reference cable (load cell), checked every step while the winches may move")
+      .why("below it the run stops (slack cable); 100 kN is beyond any cable of a CDPR");
+  t.number("max_tension", [](auto& o) -> auto& { return o.monitor.max_tension_n; }, 5000.0, {0.0, 1e5, true}, "N", "")
+      .why("above it the run stops (overload); above 100 kN (10 t) the stop would never fire on a CDPR cable");
+  t.duration("pose_stale_ms", [](auto& o) -> auto& { return o.monitor.pose_stale_us; }, 500, kMs, {1, 60'000},
+             "oldest acceptable pose sample")
+      .why("the winches move on a pose at most this old")
+      .unsafe_unless_acknowledged("> 1000", [](const CalibratorOptions& o) -> std::string {
+        if (o.monitor.pose_stale_us <= 1'000'000) return "";
+        return "longer than 1000 ms: the winches would move on (2 m at 2 m/s) with the localization lost";
+      });
   t.integer("max_consecutive_load_cell_errors",
-            [](auto& o) -> auto& { return o.monitor.max_consecutive_load_cell_errors; }, 3, {0, 1000}, "",
-            "failed reads tolerated in a row");
-  t.duration("first_contact_timeout_s", &CalibratorOptions::first_contact_timeout_us, 3.0, kS,
-             "preflight waits this long for every node's first heartbeat, the first pose and load-cell reading");
-  t.duration("enable_timeout_s", &CalibratorOptions::enable_timeout_us, 5.0, kS,
-             "drives must reach \"operation enabled\" within this");
-  t.duration("move_timeout_s", &CalibratorOptions::move_timeout_us, 600.0, kS,
-             "winches must reach a waypoint within this (else a fault)");
-  t.duration("settle_timeout_s", &CalibratorOptions::settle_timeout_us, 60.0, kS,
-             "no equilibrium within this: the waypoint is skipped");
+            [](auto& o) -> auto& { return o.monitor.max_consecutive_load_cell_errors; }, 3, {0, 100}, "",
+            "failed reads tolerated in a row")
+      .why("each is a poll without a tension check; load_cell.fault_timeout_ms bounds them in time too");
+  t.duration("first_contact_timeout_s", &CalibratorOptions::first_contact_timeout_us, 3.0, kS, {0.1, 600},
+             "preflight waits this long for every node's first heartbeat, the first pose and load-cell reading")
+      .why("nothing moves while it waits; beyond 10 minutes a missing device goes unreported");
+  t.duration("enable_timeout_s", &CalibratorOptions::enable_timeout_us, 5.0, kS, {0.1, 600},
+             "drives must reach \"operation enabled\" within this")
+      .why("nothing moves while it waits; beyond 10 minutes a drive that never enables goes unreported");
+  t.duration("move_timeout_s", &CalibratorOptions::move_timeout_us, 600.0, kS, {1, 3600},
+             "winches must reach a waypoint within this (else a fault)")
+      .why("a winch that stalls is a fault after this; an hour covers a 250 m move at any profile speed");
+  t.duration("settle_timeout_s", &CalibratorOptions::settle_timeout_us, 60.0, kS, {0.1, 3600},
+             "no equilibrium within this: the waypoint is skipped")
+      .why("the winches hold still while it waits; beyond an hour a swaying platform stalls the run");
   return t;
 }
 
@@ -123,56 +142,82 @@ Table<CalibratorOptions> waypoints_table() {
            calibration::WaypointOrder::kTour,
            "spread, informative: driven as a short tour from where the platform starts, or in the order selected");
   t.integer("count", planner(&PlannerOptions::waypoint_count), 35, {1, 10'000}, "",
-            "static poses per calibration (spread, informative)");
+            "static poses per calibration (spread, informative)")
+      .why("each is a move and a settle: 10 000 is days of robot time");
   t.number("target_anchor_sigma", [](auto& o) -> auto& { return o.sequential.target_anchor_sigma_m; }, 0.02,
-           kPositive, "m", "sequential: stop when every anchor axis 1-sigma is at most this");
+           {0.0, 1.0, true}, "m", "sequential: stop when every anchor axis 1-sigma is at most this")
+      .why("a target above 1 m calibrates nothing");
   t.number("target_offset_sigma", [](auto& o) -> auto& { return o.sequential.target_offset_sigma_m; }, 0.02,
-           kPositive, "m", "sequential: ... and every encoder offset 1-sigma at most this");
+           {0.0, 1.0, true}, "m", "sequential: ... and every encoder offset 1-sigma at most this")
+      .why("a target above 1 m calibrates nothing");
   t.integer("max_count", [](auto& o) -> auto& { return o.sequential.max_count; }, 35, {1, 10'000}, "",
-            "sequential: stop after this many samples whatever the sigmas");
-  t.number("margin", planner(&PlannerOptions::margin_m), 20.0, kNonNegative, "m",
-           "inset from the anchors' horizontal footprint");
-  t.number("z_min", planner(&PlannerOptions::z_min_m), 5.0, kAnyNumber, "m", "world height band of the platform origin");
-  t.number("z_max", planner(&PlannerOptions::z_max_m), 35.0, kAnyNumber, "m", "");
-  t.integer("grid_xy", planner(&PlannerOptions::grid_xy), 8, {1, 1000}, "", "candidate grid per horizontal axis");
-  t.integer("grid_z", planner(&PlannerOptions::grid_z), 4, {1, 1000}, "", "candidate grid along z");
+            "sequential: stop after this many samples whatever the sigmas")
+      .why("each is a move and a settle: 10 000 is days of robot time");
+  t.number("margin", planner(&PlannerOptions::margin_m), 20.0, {0.0, 1000.0}, "m",
+           "inset from the anchors' horizontal footprint")
+      .why("no CDPR is 2 km wide; the robot check refuses a margin that leaves no workspace");
+  t.number("z_min", planner(&PlannerOptions::z_min_m), 5.0, {-1000.0, 1000.0}, "m",
+           "world height band of the platform origin")
+      .why("world heights of a CDPR; the robot check keeps the band below the anchors");
+  t.number("z_max", planner(&PlannerOptions::z_max_m), 35.0, {-1000.0, 1000.0}, "m", "")
+      .why("world heights of a CDPR; the robot check keeps the band below the anchors");
+  t.integer("grid_xy", planner(&PlannerOptions::grid_xy), 8, {1, 1000}, "", "candidate grid per horizontal axis")
+      .why("grid_xy^2 x grid_z equilibrium solves at plan time");
+  t.integer("grid_z", planner(&PlannerOptions::grid_z), 4, {1, 1000}, "", "candidate grid along z")
+      .why("grid_xy^2 x grid_z equilibrium solves at plan time");
   t.number("jitter", planner(&PlannerOptions::jitter_fraction), 0.3, {0.0, 0.5, false, true}, "",
-           "candidate jitter, fraction of the grid step");
-  t.integer("seed", planner(&PlannerOptions::seed), 1, {0, 2'147'483'647}, "", "same seed, same plan");
-  t.number("min_tension", planner(&PlannerOptions::min_tension_n), 20.0, kNonNegative, "N",
-           "every cable at every waypoint (catenary statics)");
-  t.number("max_tension", planner(&PlannerOptions::max_tension_n), 3000.0, kPositive, "N", "");
-  t.number("min_payout", planner(&PlannerOptions::min_payout_m), -1e9, kAnyNumber, "m",
-           "winch travel limits in encoder units");
-  t.number("max_payout", planner(&PlannerOptions::max_payout_m), 1e9, kAnyNumber, "m", "");
-  t.number("max_sag_excess", planner(&PlannerOptions::max_sag_excess), 0.02, kPositive, "",
-           "(arc length - chord) / chord of every cable at most this");
+           "candidate jitter, fraction of the grid step")
+      .why("half a step or more lets neighbouring candidates swap");
+  t.integer("seed", planner(&PlannerOptions::seed), 1, {0, 2'147'483'647}, "", "same seed, same plan")
+      .why("any non-negative 32-bit seed");
+  t.number("min_tension", planner(&PlannerOptions::min_tension_n), 20.0, {0.0, 1e5}, "N",
+           "every cable at every waypoint (catenary statics)")
+      .why("as limits.min_tension, which the plan must keep to");
+  t.number("max_tension", planner(&PlannerOptions::max_tension_n), 3000.0, {0.0, 1e5, true}, "N", "")
+      .why("as limits.max_tension, which the plan must keep to");
+  t.number("min_payout", planner(&PlannerOptions::min_payout_m), -1e9, {-1e9, 1e9}, "m",
+           "winch travel limits in encoder units")
+      .why("+-1e9 m (the defaults) is no limit");
+  t.number("max_payout", planner(&PlannerOptions::max_payout_m), 1e9, {-1e9, 1e9}, "m", "")
+      .why("+-1e9 m (the defaults) is no limit");
+  t.number("max_sag_excess", planner(&PlannerOptions::max_sag_excess), 0.02, {0.0, 1.0, true}, "",
+           "(arc length - chord) / chord of every cable at most this")
+      .why("1 is a cable twice as long as its chord: no longer a cable robot");
   return t;
 }
 
 Table<CalibratorOptions> equilibrium_table() {
   Table<CalibratorOptions> t("equilibrium");
-  t.duration("window_s", [](auto& o) -> auto& { return o.equilibrium.window_us; }, 2.0, kS,
-             "rest window averaged into one sample row, in the pose source's own time");
+  t.duration("window_s", [](auto& o) -> auto& { return o.equilibrium.window_us; }, 2.0, kS, {0.01, 600},
+             "rest window averaged into one sample row, in the pose source's own time")
+      .why("beyond 10 minutes per waypoint the run never ends");
   t.integer("min_samples", [](auto& o) -> auto& { return o.equilibrium.min_samples; }, 100, {4, 1'000'000}, "",
-            "poses in the window; it reaches further back to hold them (100: the 2 s window at the 50 Hz loop)");
-  t.number("max_speed", [](auto& o) -> auto& { return o.equilibrium.max_speed_mps; }, 0.002, kPositive, "m/s",
-           "platform speed");
+            "poses in the window; it reaches further back to hold them (100: the 2 s window at the 50 Hz loop)")
+      .why("at least 4 for a mean and a spread; equilibrium.capacity bounds it");
+  t.number("max_speed", [](auto& o) -> auto& { return o.equilibrium.max_speed_mps; }, 0.002, {0.0, 1.0, true},
+           "m/s", "platform speed")
+      .why("a platform at 1 m/s is not at rest");
   t.number("max_angular_rate", [](auto& o) -> auto& { return o.equilibrium.max_angular_rate_radps; }, 0.002,
-           kPositive, "rad/s", "");
-  t.number("max_tension_std", [](auto& o) -> auto& { return o.equilibrium.max_tension_std_n; }, 10.0, kPositive,
-           "N", "load-cell standard deviation over the window");
+           {0.0, 1.0, true}, "rad/s", "")
+      .why("a platform turning at 1 rad/s is not at rest");
+  t.number("max_tension_std", [](auto& o) -> auto& { return o.equilibrium.max_tension_std_n; }, 10.0,
+           {0.0, 1e5, true}, "N", "load-cell standard deviation over the window")
+      .why("as limits.max_tension: a spread beyond 100 kN is no rest");
   t.boolean("estimate_sway", [](auto& o) -> auto& { return o.equilibrium.estimate_sway; }, true,
             "a platform still swaying is fitted as a decaying oscillation about its rest, and the fitted rest is "
             "the sample; false: wait until it is at rest");
-  t.duration("sway_window_s", [](auto& o) -> auto& { return o.equilibrium.sway_window_us; }, 40.0, kS,
+  t.duration("sway_window_s", [](auto& o) -> auto& { return o.equilibrium.sway_window_us; }, 40.0, kS, {0.1, 3600},
              "the sway fit's window in the pose source's own time, >= 1.5 sway periods; also the return test's: "
-             "nothing settles before it is covered (at least twice window_s)");
-  t.number("max_sway_misfit", [](auto& o) -> auto& { return o.equilibrium.max_sway_misfit; }, 1.5, kPositive, "",
-           "largest residual / noise variance of a sway fit: more is not one sway about a rest, and is waited out");
+             "nothing settles before it is covered (at least twice window_s)")
+      .why("beyond an hour per waypoint the run never ends");
+  t.number("max_sway_misfit", [](auto& o) -> auto& { return o.equilibrium.max_sway_misfit; }, 1.5,
+           {0.0, 1000.0, true}, "",
+           "largest residual / noise variance of a sway fit: more is not one sway about a rest, and is waited out")
+      .why("a misfit of 1000 noise variances takes anything for a sway");
   t.integer("capacity", &CalibratorOptions::equilibrium_capacity,
             static_cast<std::int64_t>(calibration::kEquilibriumCapacity), {2, 10'000'000}, "",
-            "ring size, >= the longer of window_s and sway_window_s x pose rate with margin");
+            "ring size, >= the longer of window_s and sway_window_s x pose rate with margin")
+      .why("allocated at start, tens of bytes a pose: 10 million is the memory of a small board");
   return t;
 }
 
@@ -181,10 +226,12 @@ Table<CalibrationOptions> solver_table() {
   t.choice("cable_model", &CalibrationOptions::cable_model,
            {{"catenary", CableModelKind::kCatenary}, {"rigid", CableModelKind::kRigid}}, CableModelKind::kCatenary,
            "");
-  t.number("huber_width", &CalibrationOptions::huber_width, 0.0, kNonNegative, "sigma",
-           "robust loss width; 0: none");
+  t.number("huber_width", &CalibrationOptions::huber_width, 0.0, {0.0, 100.0}, "sigma",
+           "robust loss width; 0: none")
+      .why("beyond 100 sigmas the loss is quadratic for every residual: 0 says none more plainly");
   t.integer("max_iterations", &CalibrationOptions::max_iterations, 1000, {1, 100'000}, "",
-            "stopping early refuses the fit");
+            "stopping early refuses the fit")
+      .why("an iteration is one sparse factorization: 100 000 is hours on a small board");
   return t;
 }
 
@@ -192,17 +239,23 @@ Table<ValidationLimits> validation_table() {
   Table<ValidationLimits> t("validation");
   t.boolean("accept_max_iterations", &ValidationLimits::accept_max_iterations, false,
             "accept a fit that ran out of iterations");
-  t.integer("min_samples", &ValidationLimits::min_samples, 10, {1, 100'000}, "", "settled waypoints needed");
-  t.number("max_rms_encoder_sigmas", &ValidationLimits::max_rms_encoder_sigmas, 3.0, kPositive, "sigma",
-           "rms encoder residual, in robot.toml noise.encoder");
-  t.number("max_rms_force_sigmas", &ValidationLimits::max_rms_force_sigmas, 3.0, kPositive, "sigma",
-           "rms force residual, in noise.force");
-  t.number("max_anchor_sigma", &ValidationLimits::max_anchor_sigma_m, 0.05, kPositive, "m",
-           "1-sigma per anchor axis");
-  t.number("max_offset_sigma", &ValidationLimits::max_offset_sigma_m, 0.05, kPositive, "m",
-           "1-sigma per encoder offset");
-  t.number("max_anchor_change", &ValidationLimits::max_anchor_change_m, 0.5, kNonNegative, "m",
-           "per anchor, from the previous calibration; 0: not checked");
+  t.integer("min_samples", &ValidationLimits::min_samples, 10, {1, 100'000}, "", "settled waypoints needed")
+      .why("no more than a run can sample (waypoints.count)");
+  t.number("max_rms_encoder_sigmas", &ValidationLimits::max_rms_encoder_sigmas, 3.0, {0.0, 1000.0, true}, "sigma",
+           "rms encoder residual, in robot.toml noise.encoder")
+      .why("a fit 1000 noise sigmas off its data is no fit");
+  t.number("max_rms_force_sigmas", &ValidationLimits::max_rms_force_sigmas, 3.0, {0.0, 1000.0, true}, "sigma",
+           "rms force residual, in noise.force")
+      .why("a fit 1000 noise sigmas off its data is no fit");
+  t.number("max_anchor_sigma", &ValidationLimits::max_anchor_sigma_m, 0.05, {0.0, 10.0, true}, "m",
+           "1-sigma per anchor axis")
+      .why("an anchor known to 10 m is not calibrated");
+  t.number("max_offset_sigma", &ValidationLimits::max_offset_sigma_m, 0.05, {0.0, 10.0, true}, "m",
+           "1-sigma per encoder offset")
+      .why("an offset known to 10 m is not calibrated");
+  t.number("max_anchor_change", &ValidationLimits::max_anchor_change_m, 0.5, {0.0, 100.0}, "m",
+           "per anchor, from the previous calibration; 0: not checked")
+      .why("an anchor 100 m from where it was is another robot");
   return t;
 }
 
@@ -252,7 +305,7 @@ Section bind(Table<T> table, Access access) {
   s.keys = infos(table);
   s.set_defaults = [table, access](DaemonConfig& c) { table.set_defaults(access(c)); };
   s.read = [table, access](TomlReader& reader, const toml::table& t, DaemonConfig& c) {
-    table.read(reader, t, table.path(), access(c), c.key_lines);
+    table.read(reader, t, table.path(), access(c), c.key_lines, c.unsafe_accepted);
   };
   s.values = [table, access](const DaemonConfig& c, Values& out) { add_values(table, table.path(), access(c), out); };
   return s;
@@ -284,7 +337,7 @@ Section bind_cables(Table<CanWinchConfig> table) {
       const std::string path = table.path() + "[" + std::to_string(i) + "]";
       refuse_unknown_keys(reader, *tables[i], path, names);
       table.set_defaults(c.winches.winches[i], static_cast<int>(i));
-      table.read(reader, *tables[i], path, c.winches.winches[i], c.key_lines);
+      table.read(reader, *tables[i], path, c.winches.winches[i], c.key_lines, c.unsafe_accepted);
     }
   };
   s.values = [table](const DaemonConfig& c, Values& out) {
@@ -345,6 +398,46 @@ const toml::table& table_at(TomlReader& reader, const toml::table& root, std::st
   return *table;
 }
 
+// After the values given are checked: a required key that is absent (its
+// table's header line, when there is one).
+void refuse_missing_keys(TomlReader& reader, const toml::table& root) {
+  for (const Section& section : sections()) {
+    for (const KeyInfo& key : section.keys) {
+      if (reader.failed() || !key.required) continue;
+      const toml::table& table = table_at(reader, root, section.path);
+      if (table.contains(key.name)) continue;
+      const int line = table.source().begin.line > 0 ? TomlReader::line_of(table) : 0;
+      reader.fail(line, formats::join_key(section.path, key.name), "missing required key: " + key.meaning);
+    }
+  }
+}
+
+// Each value that defeats a safety function needs its key in unsafe_ok; a
+// name there that is no such key is refused (a typo would acknowledge nothing).
+void refuse_unacknowledged(TomlReader& reader, const toml::table& root, const DaemonConfig& c) {
+  if (reader.failed()) return;
+  std::string acknowledgeable;
+  for (const Section& section : sections()) {
+    for (const KeyInfo& key : section.keys) {
+      if (!key.unsafe_when.empty()) acknowledgeable += " \"" + formats::join_key(section.path, key.name) + "\"";
+    }
+  }
+  const toml::node* listed = root.get("unsafe_ok");
+  for (const std::string& name : c.unsafe_ok) {
+    if (acknowledgeable.find(" \"" + name + "\"") == std::string::npos) {
+      return reader.fail(TomlReader::line_of(*listed), "unsafe_ok",
+                         "\"" + name + "\" is not a key whose unsafe values can be acknowledged; these are:" +
+                             acknowledgeable);
+    }
+  }
+  for (const UnsafeValue& value : c.unsafe_accepted) {
+    if (std::find(c.unsafe_ok.begin(), c.unsafe_ok.end(), value.key) == c.unsafe_ok.end()) {
+      return reader.fail(value.line, value.key,
+                         value.reason + "; to run so all the same, list \"" + value.key + "\" in unsafe_ok");
+    }
+  }
+}
+
 DaemonConfig read_config(TomlReader& reader, const toml::table& root) {
   DaemonConfig c = default_daemon_config();
   for (const Section& section : sections()) {
@@ -360,6 +453,8 @@ DaemonConfig read_config(TomlReader& reader, const toml::table& root) {
     refuse_unknown_keys(reader, table, section.path, names);
     section.read(reader, table, c);
   }
+  refuse_missing_keys(reader, root);
+  refuse_unacknowledged(reader, root, c);
   return c;
 }
 

@@ -3,13 +3,14 @@
 // key is one row of the tables in daemon_config.cc, with its type, unit,
 // range, default and meaning; docs/configuration.md lists them and the
 // example systemd/cdpr-calibd.toml shows each with its default (tests hold
-// both to the tables). Only `robot` is required.
+// both to the tables). `robot` and the three device endpoints are required.
 //
 // Errors (chrony conf.c): unknown keys (with the nearest known name), wrong
 // types and values out of range are refused at parse time with file, line
 // and dotted key ("cdpr-calibd.toml:40: winches.winch[2].drive_node_id:
-// must be in 1..127, got 300"), then keys that disagree with each other
-// (config_checks.h). Never throws.
+// must be in 1..127, got 300"), then missing required keys, then values
+// that defeat a safety function unless `unsafe_ok` lists their key, then
+// keys that disagree with each other (config_checks.h). Never throws.
 //
 // The drivers' settings are the drivers' own configurations, which main()
 // hands over as they are.
@@ -66,10 +67,22 @@ struct HistoryConfig {
 
 using KeyLines = std::map<std::string, int, std::less<>>;
 
+// A value given in the file that defeats a safety function (the row says
+// which values do): refused unless unsafe_ok names its key.
+struct UnsafeValue {
+  std::string key;     // dotted, as unsafe_ok names it
+  int line = 0;
+  std::string reason;  // what the value gives up
+};
+
 // The daemon's defaults are the tables' (default_daemon_config()); a
 // value-initialized DaemonConfig has only the libraries' own defaults.
 struct DaemonConfig {
   std::string robot_path;  // robot.toml
+  // Keys allowed a value that defeats a safety function (unsafe_ok); the
+  // values so accepted, which the daemon names at start.
+  std::vector<std::string> unsafe_ok;
+  std::vector<UnsafeValue> unsafe_accepted;
   store::StoreOptions store;
   HistoryConfig history;
   std::string control_socket;
@@ -98,6 +111,8 @@ struct KeyInfo {
   std::string type;          // "integer", "number", "string", "boolean", or the choices
   std::string unit;          // "m", "N", "ms", ...; empty: none
   std::string range;         // "1..127", "> 0", "[0, 0.5)", ...; empty: any value of its type
+  std::string range_reason;  // why the range is what it is
+  std::string unsafe_when;   // the values inside the range that need unsafe_ok; empty: none
   std::string default_text;  // as TOML text; empty: none
   std::string meaning;
   bool required = false;
@@ -120,5 +135,10 @@ Expected<DaemonConfig, FormatError> read_daemon_config(const std::string& path);
 // margin leaves inside the anchors and the z band below them. nullopt when
 // the configuration suits the robot.
 std::optional<FormatError> check_config_against_robot(const DaemonConfig& config, const Robot& robot);
+
+// The checks that look at the file system, before anything is opened
+// (config_checks.cc): robot names a readable file, store.state_dir is a
+// directory or absent. nullopt when both hold.
+std::optional<FormatError> check_config_paths(const DaemonConfig& config);
 
 }  // namespace cdpr::daemon

@@ -155,3 +155,21 @@ TEST(VirtualCanopenDevice, ConsumerHeartbeatLossQuickStopsPer0x6007) {
 
 }  // namespace
 }  // namespace cdpr::virtual_robot
+
+namespace cdpr::virtual_robot {
+namespace {
+
+TEST(VirtualCanopenDevice, RecordsTheLongestGapBetweenTheMastersHeartbeats) {
+  // GIVEN a drive watching node 127's heartbeat (500 ms)
+  Cia402Device d(kNode, DriveDefaults{});
+  ASSERT_EQ(write(d, 0x1016, 1, 127u << 16 | 500u, 4), 0u);
+  EXPECT_EQ(d.longest_consumer_gap_us(), 0);
+  // WHEN the heartbeats come at 0, 100, 380 and 480 ms, and another node's at 700 ms
+  for (const hal::TimeUs t : {0, 100'000, 380'000, 480'000}) d.on_frame(BusFrame{0x77F, 1, {0x05}}, t);
+  d.on_frame(BusFrame{0x77E, 1, {0x05}}, 700'000);
+  // THEN the longest gap is the master's 280 ms (what the small-computer measurement reports)
+  EXPECT_EQ(d.longest_consumer_gap_us(), 280'000);
+}
+
+}  // namespace
+}  // namespace cdpr::virtual_robot

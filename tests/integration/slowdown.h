@@ -46,4 +46,12 @@ inline double slowed_ms(double duration_ms) { return duration_ms * slowdown(); }
 // in this build for `normal` in the normal build.
 inline double robot_time_scale(double normal) { return normal / slowdown(); }
 
+// The top-level line of a daemon configuration that acknowledges the
+// timeouts the tests stretch beyond what a robot should run with (a
+// virtual robot whose physics shares a thread with its nodes, on a loaded
+// machine): docs/configuration.md, unsafe_ok.
+inline constexpr const char* kLoadedMachineUnsafeOk =
+    "unsafe_ok = [\"winches.heartbeat_timeout_ms\", \"winches.drive.consumer_heartbeat_ms\", "
+    "\"load_cell.fault_timeout_ms\", \"limits.pose_stale_ms\"]\n";
+
 }  // namespace cdpr::integration

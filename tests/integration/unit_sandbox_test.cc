@@ -199,7 +199,7 @@ class SandboxRig {
     // (fast_daemon_config): physics 20x real time, a loaded test machine
     // (both stretched in the sanitizer build: slowdown.h).
     std::ofstream config(config_path());
-    config << "robot = \"" << dir << "/robot/robot.toml\"\n"
+    config << "robot = \"" << dir << "/robot/robot.toml\"\n" << kLoadedMachineUnsafeOk
            << "[store]\nstate_dir = \"" << dir << "/state\"\n"
            << "[control]\nsocket = \"" << socket << "\"\n";
     if (!control_group.empty()) config << "group = \"" << control_group << "\"\n";

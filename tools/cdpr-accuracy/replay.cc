@@ -112,11 +112,8 @@ void score(const sim::SimulatedDataset& data, const CalibrationResult& fit, Repl
 }  // namespace
 
 calibration::PlannerOptions replay_planner_options(sim::Preset preset) {
-  calibration::PlannerOptions o;  // the daemon's [waypoints] defaults (docs/configuration.md)
-  o.margin_m = 20.0;
-  o.z_min_m = 5.0;
-  o.z_max_m = 35.0;
-  o.max_tension_n = 3000.0;
+  // The daemon's [waypoints] defaults: PlannerOptions' own (the ConfigDefaults test holds them to the key table).
+  calibration::PlannerOptions o;
   if (preset == sim::Preset::kSmall) {
     // 12.5 x 4.5 m footprint, anchors 28.5 m up, a 4.4 kg platform.
     o.margin_m = 1.0;

@@ -1,5 +1,7 @@
 #include "virtual-robot/canopen_device.h"
 
+#include <algorithm>
+
 namespace cdpr::virtual_robot {
 namespace {
 
@@ -121,7 +123,9 @@ void CanopenDevice::on_nmt(const BusFrame& frame) {
 
 void CanopenDevice::on_heartbeat_frame(int producer, hal::TimeUs now_us) {
   const std::uint32_t consumer = od_.get(0x1016, 1);
-  if (static_cast<int>((consumer >> 16) & 0x7F) == producer && (consumer & 0xFFFF) != 0) consumer_last_us_ = now_us;
+  if (static_cast<int>((consumer >> 16) & 0x7F) != producer || (consumer & 0xFFFF) == 0) return;
+  if (consumer_last_us_ >= 0) longest_consumer_gap_us_ = std::max(longest_consumer_gap_us_, now_us - consumer_last_us_);
+  consumer_last_us_ = now_us;
 }
 
 void CanopenDevice::check_consumers(hal::TimeUs now_us) {

@@ -74,6 +74,10 @@ class CanopenDevice {
   void power_on_reset() { reset(false); }
   // Emergency messages sent so far (error codes), for tests.
   const std::vector<std::uint16_t>& emergencies() const { return emergencies_; }
+  // The longest time between two heartbeats of the producer it consumes
+  // (0x1016) as this node heard them: the master's worst gap, plus any
+  // delay of the robot's own thread.
+  hal::TimeUs longest_consumer_gap_us() const { return longest_consumer_gap_us_; }
 
  protected:
   // Call once from the profile's constructor after its objects are added:
@@ -135,6 +139,7 @@ class CanopenDevice {
   int sync_count_ = 0;
   bool sync_pending_ = false;
   hal::TimeUs consumer_last_us_ = -1;  // last heartbeat of the 0x1016:01 producer; -1: not armed
+  hal::TimeUs longest_consumer_gap_us_ = 0;
   std::vector<std::uint16_t> emergencies_;
 };
 

@@ -2,6 +2,7 @@
 // frames over a Unix socket, Modbus TCP, pose stream) with physics from the
 // simulator, for running cdpr-calibd without hardware (make demo, tests).
 // Runs until SIGTERM or SIGINT.
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -93,8 +94,13 @@ int main(int argc, char** argv) {
               (*robot)->modbus_endpoint().c_str(), (*robot)->pose_endpoint().c_str());
   std::fflush(stdout);
   (*robot)->run(g_stop);
+  cdpr::hal::TimeUs heartbeat_gap_us = 0;
+  for (int winch = 0; winch < cdpr::kCableCount; ++winch) {
+    heartbeat_gap_us = std::max(heartbeat_gap_us, (*robot)->nodes().drive(winch).longest_consumer_gap_us());
+  }
   std::printf("virtual-robot: stopped (%d equilibrium solves failed, %d with a slack cable; %.1f s of robot time "
-              "not simulated while starved of CPU)\n",
-              (*robot)->physics().failed_solves(), (*robot)->physics().slack_solves(), (*robot)->robot_time_lost_s());
+              "not simulated while starved of CPU; longest gap between the master's heartbeats %.0f ms)\n",
+              (*robot)->physics().failed_solves(), (*robot)->physics().slack_solves(), (*robot)->robot_time_lost_s(),
+              1e-3 * static_cast<double>(heartbeat_gap_us));
   return 0;
 }

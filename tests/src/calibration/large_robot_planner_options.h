@@ -6,15 +6,7 @@
 
 namespace cdpr::calibration {
 
-inline PlannerOptions large_robot_planner_options() {
-  PlannerOptions options;
-  options.waypoint_count = 35;
-  options.margin_m = 20.0;
-  options.z_min_m = 5.0;
-  options.z_max_m = 35.0;
-  options.min_tension_n = 20.0;
-  options.max_tension_n = 3000.0;
-  return options;
-}
+// PlannerOptions' defaults are the daemon's (ConfigDefaults test).
+inline PlannerOptions large_robot_planner_options() { return PlannerOptions{}; }
 
 }  // namespace cdpr::calibration

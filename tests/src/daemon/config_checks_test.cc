@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "../../solver/model/test_robots.h"
+#include "config_text.h"
 #include "src/daemon/daemon_config.h"
 
 namespace cdpr::daemon {
@@ -21,7 +22,7 @@ struct Case {
 
 void expect_refused(const Case& c) {
   // GIVEN a configuration whose keys disagree WHEN parsed
-  const auto config = parse_daemon_config("robot = \"r\"\n" + c.text, "cdpr-calibd.toml");
+  const auto config = parse_daemon_config(test::config_text(c.text), "cdpr-calibd.toml");
   // THEN it is refused naming file, line and key, and saying why
   ASSERT_FALSE(config) << c.text;
   EXPECT_EQ(config.error().file, "cdpr-calibd.toml");
@@ -81,7 +82,7 @@ TEST(ConfigChecks, EndpointsOfEveryTransportAreAccepted) {
         "[pose]\nendpoint = \"unix:/run/pose.sock\"\n",
         "[winches]\nendpoint = \"unix:/run/can.sock\"\n[load_cell]\nendpoint = \"tcp:127.0.0.1:502\"\n"
         "[pose]\nendpoint = \"tcp:localization.local:5600\"\n"}) {
-    const auto config = parse_daemon_config("robot = \"r\"\n" + text, "ok.toml");
+    const auto config = parse_daemon_config(test::config_text(text), "ok.toml");
     EXPECT_TRUE(config) << config.error().message();
   }
 }
@@ -89,9 +90,9 @@ TEST(ConfigChecks, EndpointsOfEveryTransportAreAccepted) {
 TEST(ConfigChecks, TheWorkspaceAndZBandMustFitTheRobot) {
   const Robot robot = cdpr::test::large_robot();  // anchors 240 m x 220 m, 50 m high
   // GIVEN a margin that eats the footprint, and a z band reaching the anchors
-  const auto wide = parse_daemon_config("robot = \"r\"\n[waypoints]\nmargin = 130.0\n", "m.toml");
-  const auto high = parse_daemon_config("robot = \"r\"\n[waypoints]\nz_max = 55.0\n", "z.toml");
-  const auto fine = parse_daemon_config("robot = \"r\"\n", "ok.toml");
+  const auto wide = parse_daemon_config(test::config_text("[waypoints]\nmargin = 130.0\n"), "m.toml");
+  const auto high = parse_daemon_config(test::config_text("[waypoints]\nz_max = 55.0\n"), "z.toml");
+  const auto fine = parse_daemon_config(test::config_text(""), "ok.toml");
   ASSERT_TRUE(wide && high && fine);
   // WHEN checked against the robot
   const auto no_workspace = check_config_against_robot(*wide, robot);

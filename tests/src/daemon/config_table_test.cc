@@ -16,6 +16,7 @@
 
 #include <gtest/gtest.h>
 
+#include "config_text.h"
 #include "src/daemon/daemon_config.h"
 #include "drivers/modbus/load_cell_presets.h"
 
@@ -69,11 +70,15 @@ TEST(ConfigTable, TheExampleShowsEveryKeyWithItsDefault) {
   // GIVEN the example WHEN read
   const auto config = read_daemon_config(kShippedExample);
   ASSERT_TRUE(config) << config.error().message();
-  // THEN every value equals the tables' default (the robot has none)
+  // THEN every value equals the tables' default (the required keys have none)
   auto values = daemon_config_values(*config);
   auto defaults = daemon_config_values(default_daemon_config());
-  EXPECT_EQ(values.erase("robot"), 1u);
-  defaults.erase("robot");
+  for (const KeyInfo& key : daemon_config_keys()) {
+    if (!key.required) continue;
+    const std::string dotted = key.table.empty() ? key.name : key.table + "." + key.name;
+    EXPECT_EQ(values.erase(dotted), 1u) << dotted;
+    defaults.erase(dotted);
+  }
   EXPECT_EQ(values, defaults);
 }
 
@@ -101,11 +106,12 @@ std::string keys_markdown() {
       table = key.table;
       const bool array = table == "winches.winch";
       out += "\n### " + (table.empty() ? std::string("Top level") : (array ? "[[" : "[") + table + (array ? "]]" : "]")) +
-             "\n\n| Key | Type | Unit | Default | Range | Meaning |\n|---|---|---|---|---|---|\n";
+             "\n\n| Key | Type | Unit | Default | Range | Why this range | Meaning |\n|---|---|---|---|---|---|---|\n";
     }
     const std::string fallback = key.required ? "required" : key.default_text.empty() ? "" : "`" + key.default_text + "`";
+    const std::string unsafe = key.unsafe_when.empty() ? "" : "; unsafe (needs `unsafe_ok`): " + key.unsafe_when;
     out += "| `" + key.name + "` | " + escaped(key.type) + " | " + key.unit + " | " + escaped(fallback) + " | " +
-           escaped(key.range) + " | " + escaped(key.meaning) + " |\n";
+           escaped(key.range + unsafe) + " | " + escaped(key.range_reason) + " | " + escaped(key.meaning) + " |\n";
   }
   return out;
 }
@@ -127,7 +133,22 @@ TEST(ConfigTable, TheDocsPageListsTheTables) {
     return;
   }
   EXPECT_EQ(page.substr(listing, end - listing), expected + "\n")
-      << "run CDPR_UPDATE_DOCS=1 build/tests/daemon_tests --gtest_filter='ConfigTable.TheDocsPage*'";
+      << "run make docs (CDPR_UPDATE_DOCS=1 build/tests/daemon_tests --gtest_filter='ConfigTable.TheDocsPage*')";
+}
+
+TEST(ConfigTable, EveryNumberHasABoundedRangeAndItsReason) {
+  // GIVEN every key of the tables
+  for (const KeyInfo& key : daemon_config_keys()) {
+    if (key.type != "integer" && key.type != "number") continue;
+    // WHEN it is a number THEN its range is bounded on both sides ("a..b", "[a, b]", "(a, b]"), and says why
+    const bool listed = key.range.find_first_not_of("0123456789, ") == std::string::npos;  // "0, 1, 2, 5, 6"
+    const bool bounded = listed || key.range.find("..") != std::string::npos ||
+                         ((key.range.starts_with("[") || key.range.starts_with("(")) &&
+                          key.range.find("inf") == std::string::npos);
+    EXPECT_TRUE(bounded) << key.table << "." << key.name << ": " << key.range;
+    EXPECT_FALSE(key.range_reason.empty()) << key.table << "." << key.name << " does not say why its range is "
+                                           << key.range;
+  }
 }
 
 TEST(ConfigTable, RefusalsSayWhatIsWrongAndWhatIsExpected) {
@@ -139,18 +160,18 @@ TEST(ConfigTable, RefusalsSayWhatIsWrongAndWhatIsExpected) {
       {"[winches]\nmaster_node_id = 300\n", "c.toml:3: winches.master_node_id: must be in 1..127, got 300"},
       {"[loop]\nperiod_msec = 10\n", "c.toml:3: loop.period_msec: unknown key (did you mean 'period_ms'?)"},
       {"[loops]\n", "c.toml:2: loops: unknown table (did you mean 'loop'?)"},
-      {"[winches]\nmax_move_m = 0\n", "c.toml:3: winches.max_move_m: must be > 0, got 0"},
+      {"[winches]\nmax_move_m = 0\n", "c.toml:3: winches.max_move_m: must be in (0, 1000], got 0"},
       {"[waypoints]\njitter = 0.5\n", "c.toml:3: waypoints.jitter: must be in [0, 0.5), got 0.5"},
-      {"[load_cell]\nscale = 0\n", "c.toml:3: load_cell.scale: must be != 0, got 0"},
+      {"[load_cell]\nscale = 0\n", "c.toml:3: load_cell.scale: must be in [-1e+06, 1e+06], != 0, got 0"},
       {"[winches.drive]\nvendor_id = -1\n", "c.toml:3: winches.drive.vendor_id: must be in 0..0xFFFFFFFF, got -1"},
       {"[load_cell]\nbaud = \"fast\"\n", "c.toml:3: load_cell.baud: expected an integer, got a string"},
       {"[button]\nkind = \"gpoi\"\n", "c.toml:3: button.kind: \"gpoi\" is not one of \"gpio\", \"none\""},
       {"[[winches.winch]]\n[[winches.winch]]\n[[winches.winch]]\n[[winches.winch]]\nencoder_m_per_count = 0\n",
-       "c.toml:6: winches.winch[3].encoder_m_per_count: must be != 0, got 0"},
+       "c.toml:6: winches.winch[3].encoder_m_per_count: must be in [-0.01, 0.01], != 0, got 0"},
   };
   for (const Case& c : cases) {
     // GIVEN one mistake WHEN parsed THEN the message names file, line and key and says what is expected
-    const auto config = parse_daemon_config("robot = \"r\"\n" + c.text, "c.toml");
+    const auto config = parse_daemon_config(test::config_text(c.text), "c.toml");
     ASSERT_FALSE(config) << c.text;
     EXPECT_EQ(config.error().message(), c.message);
   }

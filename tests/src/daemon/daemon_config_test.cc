@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "config_text.h"
 #include "src/daemon/daemon_config.h"
 
 namespace cdpr::daemon {
@@ -44,9 +45,10 @@ TEST(DaemonConfig, TheShippedExampleParsesToTheDefaults) {
   EXPECT_EQ(drive.consumer_heartbeat_us, defaults.winches.drive.consumer_heartbeat_us);
   EXPECT_EQ(drive.pdo_event_timer_us, defaults.winches.drive.pdo_event_timer_us);
   EXPECT_EQ(config->winches.encoder.pdo_event_timer_us, defaults.winches.encoder.pdo_event_timer_us);
-  EXPECT_EQ(config->load_cell.endpoint, defaults.load_cell.endpoint);
+  EXPECT_EQ(config->winches.endpoint, "socketcan:can0");  // required: an example, not a default
+  EXPECT_EQ(config->load_cell.endpoint, "rtu:/dev/ttyUSB0");
   EXPECT_EQ(config->load_cell.response_timeout_us, defaults.load_cell.response_timeout_us);
-  EXPECT_EQ(config->pose.endpoint, defaults.pose.endpoint);
+  EXPECT_EQ(config->pose.endpoint, "tcp:127.0.0.1:5600");
   EXPECT_EQ(config->button.gpio, defaults.button.gpio);
   EXPECT_EQ(config->button.line, defaults.button.line);
   const auto& p = config->calibrator.planner;
@@ -102,7 +104,7 @@ first_contact_timeout_s = 0.5
 accept_max_iterations = true
 )";
   // WHEN parsed
-  const auto config = parse_daemon_config(text, "vr.toml");
+  const auto config = parse_daemon_config(test::with_endpoints(text), "vr.toml");
   // THEN the values are there in the daemon's units
   ASSERT_TRUE(config) << config.error().message();
   EXPECT_EQ(config->control_socket_group, "robot-operators");
@@ -166,7 +168,7 @@ TEST(DaemonConfig, RefusesBadInputNamingLineAndKey) {
   };
   for (const Case& c : cases) {
     // GIVEN a configuration with one mistake WHEN parsed
-    const auto config = parse_daemon_config(c.text, "bad.toml");
+    const auto config = parse_daemon_config(test::with_endpoints(c.text), "bad.toml");
     // THEN it is refused, naming the key (and its line where there is one)
     ASSERT_FALSE(config) << c.text;
     EXPECT_EQ(config.error().field, c.field) << config.error().message();
@@ -180,13 +182,13 @@ TEST(DaemonConfig, RefusesBadInputNamingLineAndKey) {
 TEST(DaemonConfig, TheControlSocketGroupIsANameOrANumericId) {
   for (const std::string group : {"cdpr-operators", "robot_ops", "Ops.1", "machine$", "1001", "0"}) {
     // GIVEN [control] group set to a group name or id WHEN parsed
-    const auto config = parse_daemon_config("robot = \"r\"\n[control]\ngroup = \"" + group + "\"\n", "g.toml");
+    const auto config = parse_daemon_config(test::config_text("[control]\ngroup = \"" + group + "\"\n"), "g.toml");
     // THEN it is taken as it is (whether it exists is checked when the socket is made)
     ASSERT_TRUE(config) << config.error().message();
     EXPECT_EQ(config->control_socket_group, group);
   }
   // AND a refusal says what a group must look like
-  const auto refused = parse_daemon_config("robot = \"r\"\n[control]\ngroup = \"a:b\"\n", "g.toml");
+  const auto refused = parse_daemon_config(test::config_text("[control]\ngroup = \"a:b\"\n"), "g.toml");
   ASSERT_FALSE(refused);
   EXPECT_NE(refused.error().message().find("g.toml:3"), std::string::npos) << refused.error().message();
   EXPECT_NE(refused.error().message().find("group name"), std::string::npos) << refused.error().message();

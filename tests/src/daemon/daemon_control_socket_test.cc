@@ -17,6 +17,7 @@
 
 #include "../store/store_test_support.h"
 #include "daemon_on_fakes.h"
+#include "config_text.h"
 #include "test_groups.h"
 
 namespace cdpr::daemon {
@@ -29,7 +30,7 @@ using test::DaemonOnFakes;
 DaemonConfig config_in(const std::string& dir, const std::string& control_lines) {
   const std::string text = "robot = \"" + dir + "/robot.toml\"\n[store]\nstate_dir = \"" + dir +
                            "\"\n[control]\nsocket = \"" + dir + "/control\"\n" + control_lines;
-  auto config = parse_daemon_config(text, "cdpr-calibd.toml");
+  auto config = parse_daemon_config(test::with_endpoints(text), "cdpr-calibd.toml");
   EXPECT_TRUE(config) << config.error().message();
   return config ? *config : DaemonConfig{};
 }
