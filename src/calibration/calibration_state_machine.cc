@@ -73,6 +73,7 @@ bool CalibrationStateMachine::request_start(hal::TimeUs now_us) {
   status_.started_us = now_us;
   status_.note = "started";
   enable_sent_us_.reset();
+  store_probed_ = false;
   previous_.reset();
   waypoints_ = WaypointSequence{};
   job_.reset();
@@ -242,6 +243,16 @@ void CalibrationStateMachine::step(hal::TimeUs now_us) {
   poll_button(now_us);
   refresh_device_faults();
   const CalibrationState state = status_.state;
+  if (state == CalibrationState::kPreflight && !store_probed_) {
+    // Before anything moves, and before the run's first own write (its
+    // history entry) could fail with a less telling message: a run whose fit
+    // could not be committed would be wasted.
+    store_probed_ = true;
+    if (const auto probed = devices_.store.probe_writable(); !probed) {
+      return fail("the store cannot be written (" + probed.error().message() + "): a fit could not be committed",
+                  now_us, false);
+    }
+  }
   if (in_motion_phase(state)) {
     if (std::string fault = monitor_.poll(now_us); !fault.empty()) return fail(fault, now_us, true);
     if (state == CalibrationState::kPreflight && now_us - status_.state_entered_us < options_.first_contact_timeout_us) {
@@ -273,11 +284,6 @@ void CalibrationStateMachine::step(hal::TimeUs now_us) {
 }
 
 void CalibrationStateMachine::run_preflight(hal::TimeUs now_us) {
-  // Before anything moves: a run whose fit could not be committed would be wasted.
-  if (const auto probed = devices_.store.probe_writable(); !probed) {
-    return fail("the store cannot be written (" + probed.error().message() + "): a fit could not be committed",
-                now_us, false);
-  }
   auto current = devices_.store.load_current();
   if (current) {
     previous_ = std::move(*current);

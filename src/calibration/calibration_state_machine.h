@@ -8,8 +8,8 @@
 //   any fault, or a store write the owner saw fail, while running -> abort -> failed
 //   an abort request while running -> abort -> aborted
 //
-// preflight  the store proves it can write (a run it could not commit is
-//            not started); every winch alive, pose fresh and valid, load cell
+// preflight  the store proves it can write at the run's first step (a run
+//            it could not commit is not started); every winch alive, pose fresh and valid, load cell
 //            answering and the tension inside its limits. The drives stay
 //            disabled.
 // plan       the waypoints (waypoint_sequence.h) with the current
@@ -264,6 +264,7 @@ class CalibrationStateMachine {
   CalibrationStatus status_;
   // Per run:
   std::optional<hal::TimeUs> enable_sent_us_;  // when the drives were commanded on (the plan exists)
+  bool store_probed_ = false;                  // at the run's first step (preflight)
   std::optional<store::CurrentCalibration> previous_;
   WaypointSequence waypoints_;
   std::optional<WaypointJob> job_;       // begun, not taken yet (kByOwner)
