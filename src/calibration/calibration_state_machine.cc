@@ -144,8 +144,9 @@ bool CalibrationStateMachine::request_stop_for_store(hal::TimeUs now_us, const s
   if (!is_running(status_.state)) return false;
   std::string reason = "store: " + why + ": the run's data cannot be kept";
   if (fit_validated_) {
+    // As after a failed commit: in pending/ where it can be written, in memory anyway.
     kept_fit_ = solve_result_->calibration;
-    reason += std::string("; ") + kKeptInMemory;
+    reason += keep_pending(*kept_fit_);
   }
   fail(reason, now_us, false);
   return true;
