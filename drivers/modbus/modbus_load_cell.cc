@@ -180,6 +180,7 @@ hal::Result<hal::TensionSample> ModbusLoadCell::read() {
     std::uint16_t registers[kMaxSpanRegisters] = {};
     const unsigned long long exceptions_before = counters_.exceptions;
     last = try_read(registers);
+    answered_ = answered_ || last.ok() || counters_.exceptions != exceptions_before;
     if (last.ok()) {
       const hal::Result<LoadCellReading> decoded = decode_load_cell(config_.map, registers);
       if (!decoded.ok()) {
@@ -205,8 +206,15 @@ hal::Result<hal::TensionSample> ModbusLoadCell::read() {
       connected_ = false;
     }
   }
-  return hal::Status(last.code(), last.message() + " (after " + std::to_string(tries) + " tries, " +
-                                      std::to_string(config_.response_timeout_us / 1000) + " ms timeout each)");
+  std::string text = last.message() + " (after " + std::to_string(tries) + " tries, " +
+                     std::to_string(config_.response_timeout_us / 1000) + " ms timeout each)";
+  // A gateway or a bus with the wrong unit id answers nothing at all: the
+  // most common cause of a cell that never replied.
+  if (last.code() == hal::ErrorCode::kTimeout && !answered_) {
+    text += "; the cell never answered: check that [load_cell] slave_id (" + std::to_string(config_.slave_id) +
+            ") is the device's unit id";
+  }
+  return hal::Status(last.code(), text);
 }
 
 }  // namespace cdpr::drivers::modbus

@@ -86,6 +86,7 @@ class ModbusLoadCell final : public hal::LoadCell {
   modbus_t* context_ = nullptr;
   bool connected_ = false;
   bool tcp_ = false;  // Modbus TCP (else RTU): how a late reply is got rid of
+  bool answered_ = false;  // the device replied at least once (a value or an exception)
   Counters counters_;
 };
 

@@ -16,12 +16,18 @@ const char* to_string(CalibrationState state) {
     case CalibrationState::kAbort: return "abort";
     case CalibrationState::kDone: return "done";
     case CalibrationState::kFailed: return "failed";
+    case CalibrationState::kAborted: return "aborted";
   }
   return "unknown";
 }
 
 bool is_running(CalibrationState state) {
-  return state != CalibrationState::kIdle && state != CalibrationState::kDone && state != CalibrationState::kFailed;
+  return state != CalibrationState::kIdle && state != CalibrationState::kDone && state != CalibrationState::kFailed &&
+         state != CalibrationState::kAborted;
+}
+
+bool ended_without_commit(CalibrationState state) {
+  return state == CalibrationState::kFailed || state == CalibrationState::kAborted;
 }
 
 }  // namespace cdpr::calibration

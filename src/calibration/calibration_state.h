@@ -22,12 +22,15 @@ enum class CalibrationState {
   kAbort,      // stopping the winches after a fault or an abort request
   kDone,       // last run committed a new calibration
   kFailed,     // last run stopped; status.reason says why; old calibration kept
+  kAborted,    // last run aborted on request (operator, stopping daemon); old calibration kept
 };
 
 const char* to_string(CalibrationState state);
 
 // True for the states of a run in progress (preflight .. abort).
 bool is_running(CalibrationState state);
+// True for the end of a run that committed nothing (failed, aborted).
+bool ended_without_commit(CalibrationState state);
 
 struct CalibrationStatus {
   CalibrationState state = CalibrationState::kIdle;

@@ -18,6 +18,9 @@ bool at_waypoint(CalibrationState state) {
   return state == CalibrationState::kMove || state == CalibrationState::kSettle || state == CalibrationState::kSample;
 }
 
+constexpr const char* kKeptInMemory =
+    "the fit is kept in memory until the daemon stops: fix the cause, then `calibctl commit`";
+
 bool in_motion_phase(CalibrationState state) {
   return state == CalibrationState::kPreflight || state == CalibrationState::kPlan || at_waypoint(state);
 }
@@ -70,6 +73,7 @@ bool CalibrationStateMachine::request_start(hal::TimeUs now_us) {
   status_.started_us = now_us;
   status_.note = "started";
   enable_sent_us_.reset();
+  store_probed_ = false;
   previous_.reset();
   waypoints_ = WaypointSequence{};
   job_.reset();
@@ -132,12 +136,66 @@ bool CalibrationStateMachine::request_abort(hal::TimeUs now_us, const std::strin
     status_.note = "abort ignored: no calibration running";
     return false;
   }
-  fail(why, now_us, false);
-  log_run(now_us, formats::kRunAborted);
+  fail(why, now_us, false, CalibrationState::kAborted);
   return true;
 }
 
-void CalibrationStateMachine::fail(const std::string& reason, hal::TimeUs now_us, bool fault) {
+bool CalibrationStateMachine::request_stop_for_store(hal::TimeUs now_us, const std::string& why) {
+  if (!is_running(status_.state)) return false;
+  std::string reason = "store: " + why + ": the run's data cannot be kept";
+  if (fit_validated_) {
+    // As after a failed commit: in pending/ where it can be written, in memory anyway.
+    kept_fit_ = solve_result_->calibration;
+    reason += keep_pending(*kept_fit_);
+  }
+  fail(reason, now_us, false);
+  return true;
+}
+
+bool CalibrationStateMachine::request_commit_kept(hal::TimeUs now_us) {
+  if (is_running(status_.state)) {
+    status_.note = "commit refused: a calibration is running";
+    return false;
+  }
+  const store::PendingCalibration pending(devices_.store.state_dir());
+  std::string source;
+  std::optional<store::StoreResult<int>> committed;
+  if (kept_fit_) {
+    // The newest kept fit: pending/ holds the same one, or none when it could not be written.
+    source = "memory";
+    committed = devices_.store.commit(*kept_fit_);
+    if (*committed) {
+      kept_fit_.reset();
+      (void)pending.remove();  // the same fit, or none: a leftover is reported by refresh_store_problems()
+    }
+  } else if (pending.exists()) {
+    source = pending.dir();
+    committed = pending.commit_into(devices_.store);
+  } else {
+    status_.note = "nothing to commit: no fit is kept in " + pending.dir() + " nor in memory";
+    if (status_.started_us >= 0 && !is_running(status_.state)) {
+      status_.note += std::string(" (the last run: ") + to_string(status_.state) + ": " + status_.reason + ")";
+    }
+    return false;
+  }
+  refresh_store_problems();
+  if (!*committed) {
+    status_.note = "commit of the fit kept in " + source + " failed again: " + committed->error().message();
+    return false;
+  }
+  note_commit(**committed, "from " + source, now_us);
+  return true;
+}
+
+void CalibrationStateMachine::note_commit(int seq, const std::string& what, hal::TimeUs now_us) {
+  if (is_running(status_.state)) return;
+  status_.committed_seq = seq;
+  status_.reason = status_.note = "committed calibration " + std::to_string(seq) + " " + what;
+  enter(CalibrationState::kDone, now_us);
+  refresh_store_problems();
+}
+
+void CalibrationStateMachine::fail(const std::string& reason, hal::TimeUs now_us, bool fault, CalibrationState end) {
   const std::string where = std::string(" (during ") + to_string(status_.state) +
                             (status_.waypoint > 0 ? ", waypoint " + std::to_string(status_.waypoint) + "/" +
                                                         std::to_string(status_.waypoint_count)
@@ -162,14 +220,14 @@ void CalibrationStateMachine::fail(const std::string& reason, hal::TimeUs now_us
   if (fault) run_log_.faults.push_back({run_seconds(now_us), reason + where});
   run_log_.reason = status_.reason;
   if (utc_now_text_) run_log_.finished = utc_now_text_();
-  log_run(now_us, formats::kRunFailed);
-  enter(CalibrationState::kFailed, now_us);
+  log_run(now_us, end == CalibrationState::kAborted ? formats::kRunAborted : formats::kRunFailed);
+  enter(end, now_us);
   refresh_store_problems();
 }
 
 void CalibrationStateMachine::refresh_store_problems() {
   status_.store_problems = devices_.store.problems();
-  status_.pending_commit = store::PendingCalibration(devices_.store.state_dir()).exists();
+  status_.pending_commit = kept_fit_.has_value() || store::PendingCalibration(devices_.store.state_dir()).exists();
 }
 
 void CalibrationStateMachine::poll_button(hal::TimeUs now_us) {
@@ -186,6 +244,16 @@ void CalibrationStateMachine::step(hal::TimeUs now_us) {
   poll_button(now_us);
   refresh_device_faults();
   const CalibrationState state = status_.state;
+  if (state == CalibrationState::kPreflight && !store_probed_) {
+    // Before anything moves, and before the run's first own write (its
+    // history entry) could fail with a less telling message: a run whose fit
+    // could not be committed would be wasted.
+    store_probed_ = true;
+    if (const auto probed = devices_.store.probe_writable(); !probed) {
+      return fail("the store cannot be written (" + probed.error().message() + "): a fit could not be committed",
+                  now_us, false);
+    }
+  }
   if (in_motion_phase(state)) {
     if (std::string fault = monitor_.poll(now_us); !fault.empty()) return fail(fault, now_us, true);
     if (state == CalibrationState::kPreflight && now_us - status_.state_entered_us < options_.first_contact_timeout_us) {
@@ -210,23 +278,24 @@ void CalibrationStateMachine::step(hal::TimeUs now_us) {
     case CalibrationState::kIdle:
     case CalibrationState::kAbort:
     case CalibrationState::kDone:
-    case CalibrationState::kFailed: break;
+    case CalibrationState::kFailed:
+    case CalibrationState::kAborted: break;
   }
   update_progress();
 }
 
 void CalibrationStateMachine::run_preflight(hal::TimeUs now_us) {
-  // Before anything moves: a run whose fit could not be committed would be wasted.
-  if (const auto probed = devices_.store.probe_writable(); !probed) {
-    return fail("the store cannot be written (" + probed.error().message() + "): a fit could not be committed",
-                now_us, false);
-  }
   auto current = devices_.store.load_current();
   if (current) {
     previous_ = std::move(*current);
+  } else if (auto newest = devices_.store.newest_readable_version(); newest && *newest) {
+    // The newest readable version is what the robot most likely ran on.
+    previous_ = std::move(**newest);
+    status_.note = "current calibration unreadable (" + current.error().message() +
+                   "): checking the change against history version " + std::to_string(previous_->seq);
   } else {
     status_.note = "current calibration unreadable (" + current.error().message() +
-                   "): calibrating without the change check";
+                   "): no readable version in the history either, calibrating without the change check";
   }
   enter(CalibrationState::kPlan, now_us);
 }
@@ -482,11 +551,15 @@ void CalibrationStateMachine::run_validate_and_commit(hal::TimeUs now_us) {
     }
     calibration.run = RunSummary{run_seconds(now_us), waypoints_.visited(), status_.strategy, status_.stop_reason};
     fit_validated_ = true;
+    kept_fit_.reset();  // replaced by this newer fit
     enter(CalibrationState::kCommit, now_us);
     return;
   }
   const auto committed = devices_.store.commit(calibration);
-  if (!committed) return fail("store: " + committed.error().message() + keep_pending(calibration), now_us, false);
+  if (!committed) {
+    kept_fit_ = calibration;
+    return fail("store: " + committed.error().message() + keep_pending(calibration), now_us, false);
+  }
   status_.committed_seq = *committed;
   status_.reason = "committed calibration " + std::to_string(*committed) + " from " +
                    std::to_string(samples_.size()) + " samples (rms encoder " +
@@ -504,7 +577,9 @@ void CalibrationStateMachine::run_validate_and_commit(hal::TimeUs now_us) {
 std::string CalibrationStateMachine::keep_pending(const Calibration& calibration) const {
   const store::PendingCalibration pending(devices_.store.state_dir());
   const auto kept = pending.keep(calibration, formats::format_samples_csv(samples_));
-  if (!kept) return "; keeping the fit in " + pending.dir() + " failed too: " + kept.error().message();
+  if (!kept) {
+    return "; keeping the fit in " + pending.dir() + " failed too: " + kept.error().message() + "; " + kKeptInMemory;
+  }
   return "; the fit and its " + std::to_string(samples_.size()) + " samples are kept in " + pending.dir() +
          ": fix the cause, then `calibctl commit`";
 }
@@ -536,7 +611,8 @@ void CalibrationStateMachine::update_progress() {
     case CalibrationState::kDone: status_.progress = 1.0; return;
     case CalibrationState::kIdle:
     case CalibrationState::kAbort:
-    case CalibrationState::kFailed: return;
+    case CalibrationState::kFailed:
+    case CalibrationState::kAborted: return;
   }
   if (after_job_ != AfterJob::kNone) return;  // the waypoints are away: the progress as they left
   const int count = std::max(waypoints_.expected_count(), 1);

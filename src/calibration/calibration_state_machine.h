@@ -3,12 +3,13 @@
 // state machine driven by step(now_us): pure logic with time passed in; all
 // I/O goes through the hal interfaces and the store.
 //
-//   idle/done/failed --start--> preflight -> plan -> { move -> settle -> sample }xN
+//   idle/done/failed/aborted --start--> preflight -> plan -> { move -> settle -> sample }xN
 //     -> solve -> validate -> commit -> done
-//   any fault or abort request while running -> abort -> failed
+//   any fault, or a store write the owner saw fail, while running -> abort -> failed
+//   an abort request while running -> abort -> aborted
 //
-// preflight  the store proves it can write (a run it could not commit is
-//            not started); every winch alive, pose fresh and valid, load cell
+// preflight  the store proves it can write at the run's first step (a run
+//            it could not commit is not started); every winch alive, pose fresh and valid, load cell
 //            answering and the tension inside its limits. The drives stay
 //            disabled.
 // plan       the waypoints (waypoint_sequence.h) with the current
@@ -38,13 +39,16 @@
 //            polls solve_pending(), runs calibrate() on samples() wherever it
 //            likes (a worker thread) and hands the result to
 //            deliver_solve_result().
-// validate   validate_fit() against the current calibration; then `created`
+// validate   validate_fit() against the current calibration (an unreadable
+//            current file: the newest readable history version); then `created`
 //            (from utc_now_text), `robot` and `samples` are filled in; the
 //            model terms are the solver's.
 // commit     CalibrationStore::commit(); a store error fails the run and the
 //            store guarantees the old file is intact. The fit and its
 //            samples are then kept in <state>/pending (pending_calibration.h)
-//            for a later `commit` request, so the run's work is not lost.
+//            and the fit in memory (when pending/ cannot be written either,
+//            on the same full disk) for a later `commit` request
+//            (request_commit_kept()), so the run's work is not lost.
 // abort      quick stop for a fault, halt (decelerate and hold) for an abort
 //            request; the reason goes to status().reason and, as the latest
 //            remark, to status().note.
@@ -153,6 +157,22 @@ class CalibrationStateMachine {
   // reset-faults). Refused (false, note says why) while a run is going.
   bool request_reset_faults(hal::TimeUs now_us);
   bool request_abort(hal::TimeUs now_us, const std::string& why = "abort requested");
+  // A write the run's record depends on failed (its history entry, the run
+  // marker; `why` names the path and errno): the run stops at once as for
+  // an abort (winches halted, old calibration kept) and ends "failed". A
+  // validated fit is kept as after a failed commit. False when no run is going.
+  bool request_stop_for_store(hal::TimeUs now_us, const std::string& why);
+  // The operator's `commit`: commits the fit whose commit failed, from
+  // memory when this daemon holds it (it does until the fit is committed or
+  // a newer run's fit replaces it, also when pending/ could not be written),
+  // else from pending/ (pending_calibration.h). Refused while running, or
+  // when nothing is kept (the note says why, with the last run's end).
+  // Success: state done, reason and note say what was committed.
+  bool request_commit_kept(hal::TimeUs now_us);
+  // The owner committed calibration `seq` outside a run (an operator's
+  // refit, `what` says which): the status says so (state done) instead of
+  // the last run's end. Ignored while a run is going.
+  void note_commit(int seq, const std::string& what, hal::TimeUs now_us);
 
   // Asynchronous solve (no SolveFunction given).
   bool solve_pending() const;
@@ -201,7 +221,8 @@ class CalibrationStateMachine {
 
  private:
   void enter(CalibrationState state, hal::TimeUs now_us);
-  void fail(const std::string& reason, hal::TimeUs now_us, bool fault);
+  // Ends the run in `end` (kFailed, or kAborted for an abort request).
+  void fail(const std::string& reason, hal::TimeUs now_us, bool fault, CalibrationState end = CalibrationState::kFailed);
   void poll_button(hal::TimeUs now_us);
   // status().device_faults from the winch bank's latched faults.
   void refresh_device_faults();
@@ -243,6 +264,7 @@ class CalibrationStateMachine {
   CalibrationStatus status_;
   // Per run:
   std::optional<hal::TimeUs> enable_sent_us_;  // when the drives were commanded on (the plan exists)
+  bool store_probed_ = false;                  // at the run's first step (preflight)
   std::optional<store::CurrentCalibration> previous_;
   WaypointSequence waypoints_;
   std::optional<WaypointJob> job_;       // begun, not taken yet (kByOwner)
@@ -255,6 +277,8 @@ class CalibrationStateMachine {
   std::optional<CalibrationResult> solve_result_;
   bool fit_validated_ = false;
   formats::RunLog run_log_;
+  // Across runs: the newest validated fit that was not committed (see request_commit_kept).
+  std::optional<Calibration> kept_fit_;
 };
 
 }  // namespace cdpr::calibration

@@ -2,7 +2,6 @@
 
 #include "src/control/control_request.h"
 #include "src/control/control_response.h"
-#include "src/store/pending_calibration.h"
 
 namespace cdpr::control {
 
@@ -48,20 +47,9 @@ std::string respond(std::string_view request_line, calibration::CalibrationState
                                                 rolled.error().message());
       return format_ok_response("calibration " + std::to_string(*rolled) + " is current");
     }
-    case RequestKind::kCommit: {
-      if (calibration::is_running(machine.status().state)) {
-        return format_error_response("commit refused: a calibration is running");
-      }
-      const store::PendingCalibration pending(store.state_dir());
-      if (!pending.exists()) return format_error_response("nothing to commit: no fit is kept in " + pending.dir());
-      const auto committed = pending.commit_into(store);
-      machine.refresh_store_problems();
-      if (!committed) {
-        return format_error_response("commit of the fit kept in " + pending.dir() + " failed again: " +
-                                     committed.error().message());
-      }
-      return format_ok_response("committed calibration " + std::to_string(*committed) + " from " + pending.dir());
-    }
+    case RequestKind::kCommit:
+      if (!machine.request_commit_kept(now_us)) return format_error_response(machine.status().note);
+      return format_ok_response(machine.status().note);
     case RequestKind::kRefit: {
       if (calibration::is_running(machine.status().state)) {
         return format_error_response("refit refused: a calibration is running (wait for its end or abort it)");

@@ -7,9 +7,9 @@
 //
 // rollback and commit are refused while a calibration runs (the run's
 // validation compares against the current file and its commit would
-// overwrite theirs). commit commits the fit a failed commit kept in
-// <state>/pending (pending_calibration.h); after either, the machine's view
-// of the store's problems is refreshed. refit is refused while a
+// overwrite theirs). commit commits the fit a failed commit kept (in the
+// machine's memory or in <state>/pending: request_commit_kept()); after
+// either, the machine's view of the store's problems is refreshed. refit is refused while a
 // calibration runs too, and handed to `refits` (refit_service.h) otherwise,
 // which fits on a worker: the answer says it started (or why not), status
 // says what became of it.

@@ -81,14 +81,17 @@ void DaemonLoop::report_previous_state() {
   const auto marker = run_marker_.read();
   std::string interrupted;
   std::string interrupted_at = utc_now_rfc3339();
+  std::optional<store::RunProgress> progress;
   if (!marker) {
     interrupted = "a run was interrupted (its marker is unreadable: " + marker.error() + ")";
   } else if (*marker) {
     interrupted = describe_interrupted_run(**marker);
     interrupted_at = (*marker)->updated;
+    progress = store::RunProgress{(*marker)->waypoints, (*marker)->elapsed_s};
   }
   for (const std::string& message : recorder_->recover(
-           interrupted_at, interrupted.empty() ? "the daemon stopped or died during the run" : interrupted)) {
+           interrupted_at, interrupted.empty() ? "the daemon stopped or died during the run" : interrupted,
+           progress)) {
     if (log_) log_(message);
   }
   if (!interrupted.empty()) {
@@ -105,7 +108,7 @@ void DaemonLoop::report_previous_state() {
   }
 }
 
-void DaemonLoop::track_run() {
+void DaemonLoop::track_run(hal::TimeUs now_us) {
   const calibration::CalibrationStatus& s = machine_->status();
   if (!calibration::is_running(s.state)) {
     // A marker a previous daemon left stays until a run of this one has
@@ -136,16 +139,18 @@ void DaemonLoop::track_run() {
   run_marker_now_.waypoint = s.waypoint;
   run_marker_now_.waypoints = s.waypoint_count;
   run_marker_now_.state = state;
+  run_marker_now_.elapsed_s = 1e-6 * static_cast<double>(now_us - s.started_us);
   run_marker_written_ = true;  // also after a failed write: the end of the run removes what is there
   const auto written = run_marker_.write(run_marker_now_);
-  // Logged once per kind of failure, not at every waypoint.
-  const std::string error = written ? std::string() : written.error().message();
-  if (error != run_marker_error_ && !error.empty() && log_) log_("run marker: " + error);
-  run_marker_error_ = error;
+  if (written) return;
+  // Without its marker a run that dies is not known at the next start: it stops now.
+  const std::string error = "run marker: " + written.error().message();
+  if (log_) log_(error);
+  machine_->request_stop_for_store(now_us, error);
 }
 
 void DaemonLoop::record_run() {
-  recorder_->track(*machine_, robot_);
+  recorder_->track(*machine_, robot_, clock_.now_us());
   for (const std::string& message : recorder_->take_messages()) {
     if (log_) log_(message);
   }
@@ -192,7 +197,7 @@ void DaemonLoop::step(hal::TimeUs now_us) {
   manage_waypoint_job(now_us);
   manage_solve(now_us);
   manage_refit();
-  track_run();
+  track_run(now_us);
   record_run();
   log_device_faults();
   report(now_us);
@@ -203,20 +208,24 @@ void DaemonLoop::service_idle_devices(hal::TimeUs now_us) {
   if (now_us >= next_reconnect_us_) {
     next_reconnect_us_ = now_us + kReconnectIntervalUs;
     // Logged when the outcome changes, not every round.
-    const auto reopen = [&](bool& open, std::string& last_error, const char* name, auto&& open_device) {
+    const auto reopen = [&](bool& open, std::string& last_error, const char* name, auto&& open_device,
+                            const char* opened = " connected") {
       if (open) return;
       const hal::Status status = open_device();
       open = status.ok();
       if (open) {
         last_error.clear();
-        if (log_) log_(std::string(name) + " connected");
+        if (log_) log_(std::string(name) + opened);
       } else if (status.to_string() != last_error) {
         last_error = status.to_string();
         if (log_) log_(std::string(name) + " not available (retrying): " + last_error);
       }
     };
     reopen(winches_open_, winches_error_, "winches", [&] { return devices_.winches.open(); });
-    reopen(load_cell_open_, load_cell_error_, "load cell", [&] { return devices_.load_cell.open(); });
+    // The load cell's open() starts its reader and connects: it has not answered yet.
+    reopen(load_cell_open_, load_cell_error_, "load cell", [&] { return devices_.load_cell.open(); },
+           " opened (not answered yet)");
+    if (load_cell_open_) note_load_cell_answer();
     reopen(pose_open_, pose_error_, "pose stream", [&] { return devices_.pose.open(); });
   }
   // Keep the bus and the pose stream drained so a start sees fresh data; a
@@ -235,6 +244,21 @@ void DaemonLoop::service_idle_devices(hal::TimeUs now_us) {
       pose_open_ = false;
     }
   }
+}
+
+void DaemonLoop::note_load_cell_answer() {
+  if (load_cell_answered_) return;
+  // A non-blocking read (drivers/common/load_cell_reader.h): its first reading, or why none came.
+  const hal::Result<hal::TensionSample> reading = devices_.load_cell.read();
+  if (reading.ok()) {
+    load_cell_answered_ = true;
+    load_cell_error_.clear();
+    if (log_) log_("load cell answering: " + std::to_string(static_cast<int>(std::lround(reading.value().tension_n))) + " N");
+    return;
+  }
+  if (reading.status().to_string() == load_cell_error_) return;
+  load_cell_error_ = reading.status().to_string();
+  if (log_) log_("load cell not answering: " + load_cell_error_);
 }
 
 void DaemonLoop::manage_solve(hal::TimeUs now_us) {
@@ -271,7 +295,11 @@ void DaemonLoop::manage_refit() {
   if (!refitter_->poll(calibration::is_running(machine_->status().state))) return;
   std::optional<CommittedRefit> committed = refitter_->take_committed();
   if (!committed) return;
-  machine_->refresh_store_problems();
+  // The headline says what is current now, not the last run's end.
+  machine_->note_commit(committed->seq,
+                        "by the refit of " + store::RunHistory::entry_name(committed->source_log.run) +
+                            " with the terms " + committed->terms + " (operator's choice)",
+                        clock_.now_us());
   refitter_->note_entry(recorder_->keep_refit(std::move(*committed)));
 }
 

@@ -107,6 +107,8 @@ class DaemonLoop {
  private:
   void step(hal::TimeUs now_us);
   void service_idle_devices(hal::TimeUs now_us);
+  // Idle: logs the load cell's first reading, or each new reason why none came.
+  void note_load_cell_answer();
   void manage_solve(hal::TimeUs now_us);
   // Runs the machine's waypoint job on a worker and delivers it back.
   void manage_waypoint_job(hal::TimeUs now_us);
@@ -118,7 +120,8 @@ class DaemonLoop {
   // store's problems, logged and put into the status.
   void report_previous_state();
   // Keeps the run marker (run_marker.h) in step with the machine's run.
-  void track_run();
+  // A failed write stops the run (the next start could not report it).
+  void track_run(hal::TimeUs now_us);
   // Logs the devices' latched faults (EMCY, 0x603F, a refused
   // configuration) when they appear, change or are reset.
   void log_device_faults();
@@ -141,6 +144,7 @@ class DaemonLoop {
   std::future<calibration::WaypointJob> waypoint_job_;  // valid while a job is on the worker
 
   bool winches_open_ = false, load_cell_open_ = false, pose_open_ = false;
+  bool load_cell_answered_ = false;  // a reading came since the daemon started
   std::string winches_error_, load_cell_error_, pose_error_;  // last logged open failure
   hal::TimeUs next_reconnect_us_ = 0;
   hal::TimeUs next_step_us_ = 0;
@@ -153,7 +157,6 @@ class DaemonLoop {
   bool run_marker_moving_ = false;     // the marker was written while the machine owned the hardware
   RunMarker run_marker_now_;
   hal::TimeUs run_marker_started_us_ = -1;  // monotonic start of the run the marker describes
-  std::string run_marker_error_;            // last logged write failure
   std::string logged_device_faults_;        // as last logged
 };
 

@@ -4,6 +4,7 @@
 
 #include <cerrno>
 
+#include "src/formats/number_text.h"
 #include "src/formats/toml_reader.h"
 #include "src/formats/toml_writer.h"
 #include "src/store/atomic_file.h"
@@ -17,6 +18,8 @@ std::string format_run_marker(const RunMarker& marker) {
   formats::append_line(out, "waypoint = " + std::to_string(marker.waypoint), "1-based; 0 before planning");
   formats::append_line(out, "waypoints = " + std::to_string(marker.waypoints), "planned; 0 before planning");
   formats::append_line(out, "state = " + formats::toml_string(marker.state));
+  formats::append_line(out, "elapsed_s = " + formats::shortest_text(marker.elapsed_s),
+                       "daemon's monotonic clock since the run started");
   return out;
 }
 
@@ -25,13 +28,14 @@ Expected<RunMarker, FormatError> parse_run_marker(std::string_view text, const s
     using formats::Presence;
     reader.check_keys(root, "", {{"started", Presence::kRequired}, {"updated", Presence::kRequired},
                                  {"waypoint", Presence::kRequired}, {"waypoints", Presence::kRequired},
-                                 {"state", Presence::kRequired}});
+                                 {"state", Presence::kRequired}, {"elapsed_s", Presence::kOptional}});
     RunMarker marker;
     marker.started = reader.string(root, "started", "");
     marker.updated = reader.string(root, "updated", "");
     marker.waypoint = reader.count(root, "waypoint", "");
     marker.waypoints = reader.count(root, "waypoints", "");
     marker.state = reader.string(root, "state", "");
+    marker.elapsed_s = reader.optional_number(root, "elapsed_s", "", formats::Bound::kNonNegative).value_or(0.0);
     return marker;
   });
 }

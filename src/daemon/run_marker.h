@@ -8,6 +8,8 @@
 //   waypoint = 7                       # 1-based waypoint of the run, 0 before planning
 //   waypoints = 35                     # waypoints planned, 0 before planning
 //   state = "settle"                   # the state machine's state then
+//   elapsed_s = 191.4                  # the daemon's monotonic time since the run started
+//                                      # (optional: absent in an older daemon's marker)
 //
 // The daemon loop writes it atomically (atomic_file.h) when a run starts, at
 // every new waypoint and when the motion ends (solve), and removes it when
@@ -32,6 +34,7 @@ struct RunMarker {
   int waypoint = 0;
   int waypoints = 0;
   std::string state;
+  double elapsed_s = 0.0;  // [s] daemon's monotonic clock, from the run's start to `updated`
 };
 
 std::string format_run_marker(const RunMarker& marker);

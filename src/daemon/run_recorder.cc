@@ -78,8 +78,36 @@ void RunRecorder::report(const std::string& message) {
   messages_.push_back(message);
 }
 
-void RunRecorder::write_file(int run, const char* name, const std::string& content) {
-  if (auto written = history_.write(run, name, content); !written) report("run history: " + written.error().message());
+bool RunRecorder::write_file(int run, const char* name, const std::string& content) {
+  const auto written = history_.write(run, name, content);
+  if (!written) report("run history: " + written.error().message());
+  return written.has_value();
+}
+
+void RunRecorder::note_run_write_failure(int run, const std::string& message) {
+  std::lock_guard lock(mutex_);
+  if (!write_failure_) write_failure_ = WriteFailure{run, message};
+}
+
+bool RunRecorder::write_run_file(int run, const char* name, const std::string& content) {
+  const auto written = history_.write(run, name, content);
+  if (written) return true;
+  report("run history: " + written.error().message());
+  note_run_write_failure(run, written.error().message());
+  return false;
+}
+
+formats::RunLog RunRecorder::as_written(formats::RunLog log) const {
+  // The log counts what samples.csv holds: a sample whose rewrite of the
+  // file failed is not claimed.
+  if (log.samples <= samples_written_) return log;
+  log.samples = samples_written_;
+  for (formats::RunWaypoint& w : log.waypoints) {
+    if (w.sample < samples_written_) continue;
+    w.sample = -1;
+    w.why += std::string(w.why.empty() ? "" : "; ") + "not in samples.csv: its write failed";
+  }
+  return log;
 }
 
 void RunRecorder::prune() {
@@ -101,9 +129,10 @@ void RunRecorder::prune() {
   report("run history: removed " + runs + " (oldest first) to keep within the disk budget");
 }
 
-std::vector<std::string> RunRecorder::recover(const std::string& finished, const std::string& why) {
+std::vector<std::string> RunRecorder::recover(const std::string& finished, const std::string& why,
+                                              const std::optional<store::RunProgress>& progress) {
   std::vector<std::string> messages;
-  const auto changed = history_.recover_interrupted(finished, why);
+  const auto changed = history_.recover_interrupted(finished, why, progress);
   if (!changed) {
     messages.push_back("run history: marking interrupted runs failed: " + changed.error().message());
   } else {
@@ -118,7 +147,19 @@ std::vector<std::string> RunRecorder::recover(const std::string& finished, const
   return messages;
 }
 
-void RunRecorder::track(calibration::CalibrationStateMachine& machine, const Robot& robot) {
+void RunRecorder::stop_on_write_failure(calibration::CalibrationStateMachine& machine, hal::TimeUs now_us) {
+  std::optional<WriteFailure> failure;
+  {
+    std::lock_guard lock(mutex_);
+    failure = std::exchange(write_failure_, std::nullopt);
+  }
+  if (!failure || failure->run != run_) return;
+  // Status must not name a directory that is not there (a read-only history).
+  if (!history_.exists(run_)) machine.note_run_entry("");
+  machine.request_stop_for_store(now_us, failure->message);
+}
+
+void RunRecorder::track(calibration::CalibrationStateMachine& machine, const Robot& robot, hal::TimeUs now_us) {
   const calibration::CalibrationStatus& status = machine.status();
   if (status.started_us < 0) return;
   const formats::RunLog& log = machine.run_log();
@@ -126,25 +167,35 @@ void RunRecorder::track(calibration::CalibrationStateMachine& machine, const Rob
     run_started_us_ = status.started_us;
     run_ = take_run_number();
     waypoints_queued_ = faults_queued_ = 0;
+    planned_queued_ = 0;
     fit_queued_ = solved_ = false;
     report_result_.reset();
     outcome_queued_.clear();
     machine.note_run_entry(history_.entry_path(run_));
     post([this, run = run_, robot_text = formats::format_robot_toml(robot)] {
       reported_.clear();
-      if (auto made = history_.create(run); !made) return report("run history: " + made.error().message());
-      write_file(run, store::RunHistory::kRobotName, robot_text);
+      samples_written_ = 0;
+      if (auto made = history_.create(run); !made) {
+        report("run history: " + made.error().message());
+        return note_run_write_failure(run, made.error().message());
+      }
+      write_run_file(run, store::RunHistory::kRobotName, robot_text);
     });
   }
+  // After the switch to a new run: a late failure of the last one does not stop it.
+  stop_on_write_failure(machine, now_us);
   solved_ = solved_ || status.state == calibration::CalibrationState::kSolve;
   if (status.run_diagnosis.empty()) {
     std::lock_guard lock(mutex_);
     if (checked_run_ == run_ && !checked_verdict_.empty()) machine.note_run_diagnosis(checked_verdict_);
   }
+  // The plan's size too: a run interrupted before its first sample says what was planned.
   const bool changed = log.waypoints.size() != waypoints_queued_ || log.faults.size() != faults_queued_ ||
-                       log.outcome != outcome_queued_ || (machine.validated_fit() && !fit_queued_);
+                       log.outcome != outcome_queued_ || log.waypoints_planned != planned_queued_ ||
+                       (machine.validated_fit() && !fit_queued_);
   if (!changed) return;
   const bool samples_changed = outcome_queued_.empty() || log.waypoints.size() != waypoints_queued_;
+  planned_queued_ = log.waypoints_planned;
   waypoints_queued_ = log.waypoints.size();
   faults_queued_ = log.faults.size();
   outcome_queued_ = log.outcome;
@@ -164,11 +215,13 @@ void RunRecorder::track(calibration::CalibrationStateMachine& machine, const Rob
   // Copies: the model check below needs them too.
   post([this, run = run_, snapshot, samples, samples_changed,
         fit_text = std::move(fit_text), ended] {
-    const auto write = [&](const char* name, const std::string& content) { write_file(run, name, content); };
+    const auto write = [&](const char* name, const std::string& content) { return write_run_file(run, name, content); };
     // Samples before the log that counts them; the fit before the log that says it was committed.
-    if (samples_changed) write(store::RunHistory::kSamplesName, formats::format_samples_csv(samples));
+    if (samples_changed && write(store::RunHistory::kSamplesName, formats::format_samples_csv(samples))) {
+      samples_written_ = static_cast<int>(samples.size());
+    }
     if (!fit_text.empty()) write(store::RunHistory::kCalibrationName, fit_text);
-    write(store::RunHistory::kLogName, formats::format_run_log_toml(snapshot));
+    write(store::RunHistory::kLogName, formats::format_run_log_toml(as_written(snapshot)));
     if (ended) prune();
   });
   if (with_report) {

@@ -16,9 +16,15 @@
 // The writes (each several fsyncs) run in order on a thread of their own,
 // so that a slow or full disk (or a long model check) never stalls the loop
 // that watches the winches: track() only copies the run's log and samples
-// into a queue. A next run's writes wait behind a model check in progress. A
-// failed write is never fatal and does not touch the calibration: it is
-// reported by take_messages() (path and errno), once per file and run.
+// into a queue. A next run's writes wait behind a model check in progress.
+// A failed write is reported by take_messages() (path and errno), once per
+// file and run. The first failed write of a running run's record (its
+// entry, robot.toml, samples.csv, calibration.toml, run.toml) also stops
+// the run at the next track() (request_stop_for_store(): a run whose data
+// cannot be kept is not worth the robot's time); and status then names no
+// entry when its directory could not be made. A run.toml never counts more
+// samples than its samples.csv holds. Writes after the run (its report,
+// the model check's verdict, a refit's entry) are only reported.
 //
 // Thread-safety: track(), recover(), take_messages() and finish() from one
 // thread (the daemon's loop); the writer thread is internal.
@@ -59,12 +65,15 @@ class RunRecorder {
   // At start-up, before the first run: entries a daemon that died left
   // "running" become "interrupted" (with `why`), then the history is pruned
   // to its budget. Synchronous. Returns one message per event or failure.
-  std::vector<std::string> recover(const std::string& finished, const std::string& why);
+  // `progress`: what the run marker knew of the newest run (RunHistory::recover_interrupted).
+  std::vector<std::string> recover(const std::string& finished, const std::string& why,
+                                   const std::optional<store::RunProgress>& progress = std::nullopt);
 
   // After every step of `machine`: queues the writes the run's progress
   // calls for, names the entry in the machine's status and, once the model
   // check of its run is done, puts its verdict there too.
-  void track(calibration::CalibrationStateMachine& machine, const Robot& robot);
+  // `now_us`: the loop's monotonic time, for stopping the run.
+  void track(calibration::CalibrationStateMachine& machine, const Robot& robot, hal::TimeUs now_us);
 
   // Between runs (loop thread): keeps a refit the operator had committed
   // (run_refitter.h) as an entry of its own, so that `calibctl show` finds
@@ -92,7 +101,14 @@ class RunRecorder {
   void report(const std::string& message);
   void prune();
   // On the writer thread: file `name` of entry `run`, a failure reported.
-  void write_file(int run, const char* name, const std::string& content);
+  bool write_file(int run, const char* name, const std::string& content);
+  // The same for a file of the run's record: a failure also stops the run.
+  bool write_run_file(int run, const char* name, const std::string& content);
+  void note_run_write_failure(int run, const std::string& message);
+  // Writer thread: `log` claiming no more samples than samples.csv holds.
+  formats::RunLog as_written(formats::RunLog log) const;
+  // Loop thread: a failed write of the tracked run stops it.
+  void stop_on_write_failure(calibration::CalibrationStateMachine& machine, hal::TimeUs now_us);
   // On the writer thread: the model check of a finished run, its verdict into run.toml.
   void check_model(int run, formats::RunLog log, const Robot& robot, const std::vector<Sample>& samples);
   // On the writer thread: report.html of a run that ended with a validated fit.
@@ -114,6 +130,7 @@ class RunRecorder {
   int next_run_ = 0;
   std::size_t waypoints_queued_ = 0;
   std::size_t faults_queued_ = 0;
+  int planned_queued_ = 0;
   std::string outcome_queued_;
   bool fit_queued_ = false;
   bool solved_ = false;  // the run reached its solve
@@ -129,6 +146,12 @@ class RunRecorder {
   int checked_run_ = 0;          // the run of the latest model check done
   std::string checked_verdict_;  // and its verdict
   std::set<std::string> reported_;  // this run's, writer thread only
+  int samples_written_ = 0;          // rows of this run's samples.csv on disk, writer thread only
+  struct WriteFailure {
+    int run = 0;
+    std::string message;  // "write <path>: No space left on device"
+  };
+  std::optional<WriteFailure> write_failure_;  // the first since the loop last looked
   std::thread writer_;
 };
 

@@ -57,22 +57,26 @@ StoreResult<Done> write_file_atomically(const std::string& dir, const std::strin
   const std::string final_path = dir + "/" + name;
   FileDescriptor file(::open(temp_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
   if (file.get() < 0) return Unexpected{errno_error("open", temp_path)};
+  // A real failure (a full disk, EIO) removes the temp file: a full disk
+  // keeps no half-written files, and the old file is untouched. A simulated
+  // crash leaves everything as a kill would.
+  const auto failed = [&](const char* operation) {
+    StoreError error = errno_error(operation, temp_path);
+    ::unlink(temp_path.c_str());
+    return Unexpected{std::move(error)};
+  };
 
   const std::size_t half = content.size() / 2;
-  if (!write_all(file.get(), content.substr(0, half))) return Unexpected{errno_error("write", temp_path)};
+  if (!write_all(file.get(), content.substr(0, half))) return failed("write");
   if (crash_requested(hook, first_step)) return Unexpected{simulated_crash(temp_path, first_step)};
-  if (!write_all(file.get(), content.substr(half))) return Unexpected{errno_error("write", temp_path)};
+  if (!write_all(file.get(), content.substr(half))) return failed("write");
   if (crash_requested(hook, first_step + 1)) return Unexpected{simulated_crash(temp_path, first_step + 1)};
 
-  if (::fsync(file.get()) != 0) return Unexpected{errno_error("fsync", temp_path)};
-  if (!file.close()) return Unexpected{errno_error("close", temp_path)};
+  if (::fsync(file.get()) != 0) return failed("fsync");
+  if (!file.close()) return failed("close");
   if (crash_requested(hook, first_step + 2)) return Unexpected{simulated_crash(temp_path, first_step + 2)};
 
-  if (::rename(temp_path.c_str(), final_path.c_str()) != 0) {
-    StoreError error = errno_error("rename", temp_path);
-    ::unlink(temp_path.c_str());  // leave no stray temp; the old file is untouched
-    return Unexpected{error};
-  }
+  if (::rename(temp_path.c_str(), final_path.c_str()) != 0) return failed("rename");
   const int renamed_step = first_step + kAtomicRenameStepOffset;
   if (crash_requested(hook, renamed_step)) return Unexpected{simulated_crash(final_path, renamed_step)};
 

@@ -30,7 +30,8 @@ inline constexpr int kAtomicWriteSteps = 5;
 inline constexpr int kAtomicRenameStepOffset = 3;
 
 // Replaces dir/name by `content` as above. A simulated crash returns a
-// StoreError with operation "crash".
+// StoreError with operation "crash" and leaves the files as they are; any
+// other failure (ENOSPC, EIO) removes the temp file before it returns.
 [[nodiscard]] StoreResult<Done> write_file_atomically(const std::string& dir, const std::string& name,
                                                      std::string_view content, const CrashHook& hook, int first_step);
 

@@ -111,6 +111,20 @@ StoreResult<std::optional<CurrentCalibration>> CalibrationStore::load_current() 
   return std::optional<CurrentCalibration>{std::move(current)};
 }
 
+StoreResult<std::optional<CurrentCalibration>> CalibrationStore::newest_readable_version() const {
+  const auto seqs = history_seqs();
+  if (!seqs) return Unexpected{seqs.error()};
+  for (const int seq : *seqs) {
+    const std::string path = history_dir() + "/" + history_name(seq);
+    auto text = read_file(path);
+    if (!text) continue;
+    auto calibration = parse_text(*text, path);
+    if (!calibration) continue;
+    return std::optional<CurrentCalibration>{CurrentCalibration{std::move(*calibration), std::move(*text), seq}};
+  }
+  return std::optional<CurrentCalibration>{};
+}
+
 StoreResult<int> CalibrationStore::commit(const Calibration& calibration) {
   return commit_text(formats::format_calibration_toml(calibration));
 }

@@ -75,6 +75,11 @@ class CalibrationStore {
   // but unreadable or unparsable file is an error (operation "parse").
   [[nodiscard]] StoreResult<std::optional<CurrentCalibration>> load_current() const;
 
+  // The newest history version that reads and parses (seq set), for the
+  // change check when calibration.toml itself is unreadable; empty when
+  // none does.
+  [[nodiscard]] StoreResult<std::optional<CurrentCalibration>> newest_readable_version() const;
+
   // Formats and commits `calibration`; returns its sequence number.
   [[nodiscard]] StoreResult<int> commit(const Calibration& calibration);
   // Commits text that must parse as calibration.toml.

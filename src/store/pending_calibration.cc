@@ -41,12 +41,20 @@ StoreResult<int> PendingCalibration::commit_into(CalibrationStore& store) const 
   if (!text) return Unexpected{text.error()};
   const auto committed = store.commit_text(*text);
   if (!committed) return committed;
+  if (auto removed = remove(); !removed) return Unexpected{removed.error()};
+  return committed;
+}
+
+StoreResult<Done> PendingCalibration::remove() const {
   for (const char* name : {kCalibrationName, kSamplesName}) {
-    if (auto removed = remove_file(dir_ + "/" + name); !removed) return Unexpected{removed.error()};
+    if (auto removed = remove_file(dir_ + "/" + name); !removed) return removed;
+  }
+  // Temp files of a keep() a crash interrupted would keep the directory.
+  for (const char* name : {kCalibrationName, kSamplesName}) {
+    if (auto removed = remove_file(dir_ + "/" + temp_name(name)); !removed) return removed;
   }
   if (::rmdir(dir_.c_str()) != 0 && errno != ENOENT) return Unexpected{errno_error("rmdir", dir_)};
-  if (auto synced = fsync_directory(parent_of(dir_)); !synced) return Unexpected{synced.error()};
-  return committed;
+  return fsync_directory(parent_of(dir_));
 }
 
 }  // namespace cdpr::store

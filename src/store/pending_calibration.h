@@ -37,6 +37,8 @@ class PendingCalibration {
   // the new sequence number. Errors: nothing pending (operation "read",
   // ENOENT), the store's commit error (pending/ is kept), or the removal's.
   [[nodiscard]] StoreResult<int> commit_into(CalibrationStore& store) const;
+  // Removes pending/ and its files (absent is fine), durably.
+  [[nodiscard]] StoreResult<Done> remove() const;
 
   const std::string& dir() const { return dir_; }
 

@@ -102,8 +102,8 @@ StoreResult<Done> RunHistory::write(int run, const std::string& name, std::strin
   return write_file_atomically(entry_path(run), name, content, {}, 1);
 }
 
-StoreResult<std::vector<int>> RunHistory::recover_interrupted(const std::string& finished,
-                                                              const std::string& why) const {
+StoreResult<std::vector<int>> RunHistory::recover_interrupted(const std::string& finished, const std::string& why,
+                                                              const std::optional<RunProgress>& newest) const {
   const auto found = runs();
   if (!found) return Unexpected{found.error()};
   std::vector<int> changed;
@@ -119,6 +119,10 @@ StoreResult<std::vector<int>> RunHistory::recover_interrupted(const std::string&
     entry.log.outcome = formats::kRunInterrupted;
     entry.log.reason = why;
     entry.log.finished = finished;
+    if (newest && run == found->back()) {
+      entry.log.waypoints_planned = std::max(entry.log.waypoints_planned, newest->waypoints_planned);
+      entry.log.robot_time_s = std::max(entry.log.robot_time_s, newest->robot_time_s);
+    }
     if (auto written = write(run, kLogName, formats::format_run_log_toml(entry.log)); !written) {
       return Unexpected{written.error()};
     }

@@ -37,6 +37,13 @@
 
 namespace cdpr::store {
 
+// How far the newest run had come when its daemon stopped (the run marker,
+// written at every waypoint): run.toml is only rewritten at a sample.
+struct RunProgress {
+  int waypoints_planned = 0;
+  double robot_time_s = 0.0;  // [s] daemon's monotonic clock since the run started
+};
+
 struct RunEntry {
   int run = 0;
   std::string path;         // the entry's directory
@@ -73,8 +80,12 @@ class RunHistory {
 
   // Entries still "running" (their daemon stopped or died mid-run) become
   // "interrupted" with `why` as the reason; temp files a crash left in any
-  // entry are removed. Returns the entries changed.
-  [[nodiscard]] StoreResult<std::vector<int>> recover_interrupted(const std::string& finished, const std::string& why) const;
+  // entry are removed. `newest`: the newest such entry's waypoints planned
+  // and robot time, where they exceed what its run.toml says. Returns the
+  // entries changed.
+  [[nodiscard]] StoreResult<std::vector<int>> recover_interrupted(
+      const std::string& finished, const std::string& why,
+      const std::optional<RunProgress>& newest = std::nullopt) const;
 
   // Removes the oldest unprotected entries until all fit `budget_bytes`
   // (see above); returns the runs removed, oldest first.

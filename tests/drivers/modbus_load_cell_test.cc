@@ -17,8 +17,9 @@
 namespace cdpr::drivers::modbus {
 namespace {
 
-ModbusLoadCellConfig config_for(int port) {
+ModbusLoadCellConfig config_for(int port, int slave_id = ModbusLoadCellConfig{}.slave_id) {
   ModbusLoadCellConfig config;
+  config.slave_id = slave_id;
   config.endpoint = "tcp:127.0.0.1:" + std::to_string(port);
   config.response_timeout_us = 50'000;
   config.retries = 2;
@@ -93,6 +94,30 @@ TEST(ModbusLoadCell, SilentServerTimesOutAfterRetries) {
   const auto again = cell.read();
   ASSERT_TRUE(again.ok()) << again.status().to_string();
   EXPECT_FLOAT_EQ(again.value().tension_n, 100.0f);
+}
+
+TEST(ModbusLoadCell, ACellThatNeverAnsweredTimesOutWithAHintToCheckTheUnitId) {
+  // GIVEN a device that accepts the connection but ignores our unit id (as a wrong slave_id does)
+  test::FakeModbusLoadCell server;
+  server.mute(true);
+  fakes::ManualClock clock;
+  ModbusLoadCell cell(config_for(server.port(), 7), clock);
+  ASSERT_TRUE(cell.open().ok());
+  // WHEN read
+  const auto sample = cell.read();
+  // THEN it times out, pointing at slave_id
+  ASSERT_FALSE(sample.ok());
+  EXPECT_EQ(sample.status().code(), hal::ErrorCode::kTimeout);
+  EXPECT_NE(sample.status().message().find("never answered: check that [load_cell] slave_id (7) is the device's unit id"),
+            std::string::npos)
+      << sample.status().message();
+  // AND WHEN a cell that did answer falls silent THEN the timeout does not blame the unit id
+  server.mute(false);
+  ASSERT_TRUE(cell.read().ok());
+  server.mute(true);
+  const auto silent = cell.read();
+  ASSERT_FALSE(silent.ok());
+  EXPECT_EQ(silent.status().message().find("slave_id"), std::string::npos) << silent.status().message();
 }
 
 TEST(ModbusLoadCell, ALateReplyOverTcpIsNeverTakenForALaterAnswer) {
@@ -289,9 +314,7 @@ TEST(ModbusLoadCell, TalksToATcpDeviceAsUnit255) {
   test::FakeModbusLoadCell server;
   server.set(42.0, true);
   fakes::ManualClock clock;
-  ModbusLoadCellConfig config = config_for(server.port());
-  config.slave_id = 255;
-  ModbusLoadCell cell(config, clock);
+  ModbusLoadCell cell(config_for(server.port(), 255), clock);
   // WHEN opened and read THEN the reading comes through
   ASSERT_TRUE(cell.open().ok());
   const auto sample = cell.read();

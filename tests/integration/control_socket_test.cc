@@ -78,7 +78,7 @@ TEST(ControlSocket, ConcurrentClientsEachGetTheirAnswersAndStartOneRunOnly) {
   EXPECT_EQ(refused, 3);
   EXPECT_TRUE(rig.ask("status")["running"].boolean());
 
-  // AND WHEN the operator aborts THEN the run ends failed with the abort as its reason
+  // AND WHEN the operator aborts THEN the run ends aborted with the abort as its reason
   EXPECT_TRUE(rig.ask("abort")["ok"].boolean());
   calibctl::JsonValue status = rig.ask("status");
   for (int n = 0; n < 50 && status["running"].boolean(); ++n) {  // the abort state stops the winches first
@@ -86,7 +86,7 @@ TEST(ControlSocket, ConcurrentClientsEachGetTheirAnswersAndStartOneRunOnly) {
     status = rig.ask("status");
   }
   EXPECT_FALSE(status["running"].boolean());
-  EXPECT_EQ(status["state"].string(), "failed");
+  EXPECT_EQ(status["state"].string(), "aborted");
   EXPECT_NE(status["reason"].string().find("abort"), std::string::npos) << status["reason"].string();
   EXPECT_FALSE(rig.ask("show")["present"].boolean());  // nothing committed
 }

@@ -111,7 +111,8 @@ int follow(ControlClient& client, const Options& options) {
     }
     if (!(*status)["running"].boolean()) {
       if (!options.json) std::printf("%s", cdpr::calibctl::render_status(*status).c_str());
-      return (*status)["state"].string() == "failed" ? kExitRefused : 0;
+      const std::string state = (*status)["state"].string();
+      return state == "failed" || state == "aborted" ? kExitRefused : 0;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(options.interval_ms));
   }

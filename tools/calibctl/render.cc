@@ -15,8 +15,32 @@ std::string format(const char* pattern, Args... args) {
   return buffer;
 }
 
+// Status lines longer than this are wrapped (at spaces; a longer word, such
+// as a path, stays whole), so that each label starts a line of its own.
+constexpr std::size_t kLineWidth = 100;
+
+// "  label: text", wrapped with the continuation indented.
+void append_wrapped(std::string& out, const std::string& label, const std::string& text) {
+  std::string line = "  " + label + ":";
+  const std::string indent = "    ";
+  std::size_t at = 0;
+  while (at < text.size()) {
+    std::size_t end = text.find(' ', at);
+    if (end == std::string::npos) end = text.size();
+    const std::string word = text.substr(at, end - at);
+    if (line.size() + 1 + word.size() > kLineWidth && line.size() > indent.size() + 3 + label.size()) {
+      out += line + "\n";
+      line = indent + word;
+    } else if (!word.empty() || line.size() > indent.size()) {
+      line += " " + word;
+    }
+    at = end + 1;
+  }
+  out += line + "\n";
+}
+
 void append_if(std::string& out, const char* label, const JsonValue& text) {
-  if (!text.string().empty()) out += format("  %s: %s\n", label, text.string().c_str());
+  if (!text.string().empty()) append_wrapped(out, label, text.string());
 }
 
 double at(const JsonValue& vector, std::size_t k) {
@@ -36,11 +60,12 @@ void append_refit_hint(std::string& out, const JsonValue& run) {
          (name.empty() ? "" : " " + name) + "\n";
 }
 
-// "robot time 412.3 s, about 180 s left; largest sigma: anchor 0.031 m (target 0.02), offset ..."
+// "elapsed 412.3 s (daemon clock), about 180 s left; largest sigma: anchor 0.031 m (target 0.02), offset ..."
 std::string waypoint_progress(const JsonValue& s) {
   if (s["strategy"].string().empty()) return "";
   std::string out = "  " + s["strategy"].string();
-  if (!s["elapsed_s"].is_null()) out += format(": robot time %.1f s", s["elapsed_s"].number());
+  // elapsed_s is the daemon's monotonic clock, not the robot's (a virtual robot's runs faster).
+  if (!s["elapsed_s"].is_null()) out += format(": elapsed %.1f s (daemon clock)", s["elapsed_s"].number());
   if (!s["time_left_s"].is_null()) out += format(", about %.0f s left", s["time_left_s"].number());
   if (!s["stop_reason"].string().empty()) out += " (waypoints ended: " + s["stop_reason"].string() + ")";
   if (const JsonValue sigma = s["sigma"]; !sigma.is_null()) {
@@ -84,10 +109,14 @@ std::string render_status(const JsonValue& s) {
   }
   if (const JsonValue run = s["run"]; !run.is_null()) {
     const std::string entry = run["entry"].string();
-    out += format("  run: %s, %d samples, data in %s\n", run["outcome"].string().c_str(), run["samples"].integer(),
-                  entry.empty() ? "(not kept)" : entry.c_str());
+    out += "  run: " + run["outcome"].string() + format(", %d samples, data in ", run["samples"].integer()) +
+           (entry.empty() ? "(not kept)" : entry) + "\n";
     append_if(out, "model check", run["diagnosis"]);
-    append_refit_hint(out, run);
+    // Once the refit of this run is committed, the hint is done with.
+    const JsonValue refit = s["refit"];
+    const bool refit_committed =
+        !refit.is_null() && refit["state"].string() == "committed" && entry.ends_with("/" + refit["run"].string());
+    if (!refit_committed) append_refit_hint(out, run);
   }
   if (const JsonValue refit = s["refit"]; !refit.is_null()) out += "  " + render_refit(refit);
   return out;

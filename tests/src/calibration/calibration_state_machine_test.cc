@@ -20,8 +20,9 @@ using test::CalibrationRig;
 using ::cdpr::test::contains;
 
 // The common end of every fault test.
-void expect_failed_safely(const CalibrationRig& rig, const std::string& reason_words) {
-  EXPECT_EQ(rig.status().state, CalibrationState::kFailed);
+void expect_failed_safely(const CalibrationRig& rig, const std::string& reason_words,
+                          CalibrationState end = CalibrationState::kFailed) {
+  EXPECT_EQ(rig.status().state, end);
   EXPECT_TRUE(contains(rig.status().reason, reason_words)) << rig.status().reason;
   EXPECT_TRUE(contains(rig.status().reason, "previous calibration kept")) << rig.status().reason;
   EXPECT_TRUE(rig.winches.all_stopped());
@@ -233,12 +234,15 @@ TEST(CalibrationStateMachine, AbortMidRunHaltsAndKeepsTheOldCalibration) {
   // WHEN an abort is requested
   EXPECT_TRUE(rig.machine->request_abort(rig.clock.now_us()));
   // THEN the winches are halted at once, the reason says so, nothing was committed
-  expect_failed_safely(rig, "abort requested (during move, waypoint 3/6)");
+  expect_failed_safely(rig, "abort requested (during move, waypoint 3/6)", CalibrationState::kAborted);
   EXPECT_GE(rig.winches.halts(), 1);
   // AND further steps leave everything stopped
   rig.run_until([] { return false; }, 2'000'000);
   EXPECT_TRUE(rig.winches.all_stopped());
-  EXPECT_EQ(rig.status().state, CalibrationState::kFailed);
+  // AND the run is shown "aborted", as its run.toml says
+  EXPECT_EQ(rig.status().state, CalibrationState::kAborted);
+  EXPECT_EQ(to_string(rig.status().state), std::string("aborted"));
+  EXPECT_EQ(rig.machine->run_log().outcome, formats::kRunAborted);
 }
 
 TEST(CalibrationStateMachine, FailureDuringCommitKeepsTheOldCalibrationByteForByte) {

@@ -167,9 +167,9 @@ TEST(WaypointJobs, AnAbortDuringPlanningHaltsAndDropsThePlan) {
   ASSERT_TRUE(job.problem.empty()) << job.problem;
   owner.machine->deliver_waypoint_job(std::move(job), owner.rig.clock.now_us());
   for (int k = 0; k < 100; ++k) owner.step();
-  // THEN the winches were halted, the run failed as aborted, and the plan was dropped
+  // THEN the winches were halted, the run ended aborted, and the plan was dropped
   EXPECT_EQ(owner.rig.winches.halts(), halts + 1);
-  EXPECT_EQ(owner.machine->status().state, CalibrationState::kFailed);
+  EXPECT_EQ(owner.machine->status().state, CalibrationState::kAborted);
   EXPECT_EQ(owner.machine->run_log().outcome, formats::kRunAborted);
   EXPECT_EQ(owner.machine->status().waypoint_count, 0);
   EXPECT_EQ(owner.machine->status().waypoint, 0);

@@ -5,12 +5,14 @@
 
 #include "src/daemon/run_marker.h"
 
+#include <filesystem>
 #include <fstream>
 
 #include <gtest/gtest.h>
 
 #include "../store/store_test_support.h"
 #include "daemon_on_fakes.h"
+#include "src/formats/run_log_toml.h"
 
 namespace cdpr::daemon {
 namespace {
@@ -56,6 +58,34 @@ TEST(RunMarker, ADaemonStartingOverAMarkerReportsTheInterruptedRun) {
   EXPECT_EQ(status.interrupted.substr(0, 57), "run interrupted at 2026-11-25T17:43:10Z, waypoint 7 of 35")
       << status.interrupted;
   EXPECT_TRUE(file.read() && file.read()->has_value());
+}
+
+TEST(RunMarker, AnInterruptedRunsLogGetsThePlanAndTheTimeItsMarkerKnew) {
+  // GIVEN a run killed at waypoint 7 of 35, 191.4 s after its start, before its run.toml was rewritten
+  store::test::TempStateDir dir;
+  const RunMarkerFile file(dir.path());
+  RunMarker marker = marker_at_waypoint_7();
+  marker.elapsed_s = 191.4;
+  ASSERT_TRUE(file.write(marker));
+  const std::string entry = dir.path() + "/history/run-000001";
+  std::filesystem::create_directories(entry);
+  formats::RunLog running;
+  running.run = 1;
+  running.started = marker.started;
+  std::ofstream(entry + "/run.toml") << formats::format_run_log_toml(running);
+  // WHEN a daemon starts there
+  DaemonOnFakes daemon(config_in(dir.path()));
+  ASSERT_TRUE(daemon.start().ok());
+  // THEN the run's log is interrupted with the real plan size and time, not zeros
+  const auto log = formats::read_run_log_toml(entry + "/run.toml");
+  ASSERT_TRUE(log) << log.error().message();
+  EXPECT_EQ(log->outcome, "interrupted");
+  EXPECT_EQ(log->waypoints_planned, 35);
+  EXPECT_DOUBLE_EQ(log->robot_time_s, 191.4);
+  // AND the marker round-trips its elapsed time
+  const auto read = file.read();
+  ASSERT_TRUE(read && read->has_value());
+  EXPECT_DOUBLE_EQ((*read)->elapsed_s, 191.4);
 }
 
 TEST(RunMarker, AnUnreadableMarkerStillReportsAnInterruptedRun) {

@@ -1,8 +1,8 @@
 // Every run's data kept (state machine against fakes, recorder as the
 // daemon loop drives it): committed, aborted and interrupted runs keep
 // their samples, robot.toml and log; the disk budget prunes the oldest but
-// never the current calibration's run; an entry that cannot be written is
-// logged and the calibration commits all the same.
+// never the current calibration's run; an entry that cannot be written stops
+// the run and is logged.
 
 #include "src/daemon/run_recorder.h"
 
@@ -42,8 +42,10 @@ class RecordedRig {
     for (std::string& message : recorder->recover("2026-11-23T08:00:00Z", "died")) messages.push_back(message);
   }
   bool run_until(const std::function<bool()>& done) {
+    // The writer keeps up: a failed write is seen at the next step, as in a daemon with a fast disk.
     return rig.run_until([&] {
-      recorder->track(*rig.machine, rig.robot);
+      recorder->track(*rig.machine, rig.robot, rig.clock.now_us());
+      recorder->wait_idle();
       return done();
     });
   }
@@ -208,15 +210,20 @@ TEST(RunRecorder, TheBudgetPrunesOlderRunsButNeverTheCurrentCalibrationsNorTheLa
   EXPECT_TRUE(contains(joined(r.messages), "removed run-000002")) << joined(r.messages);
 }
 
-TEST(RunRecorder, AnEntryThatCannotBeWrittenIsLoggedAndTheCalibrationStillCommits) {
+TEST(RunRecorder, AnEntryThatCannotBeWrittenStopsTheRunAndIsLoggedOncePerFile) {
   // GIVEN a file where the run's entry directory would go (writes below it fail, for root too)
   RecordedRig r;
   std::ofstream(r.entry(1)) << "in the way\n";
   // WHEN a calibration runs
   ASSERT_TRUE(r.run_to_end());
-  // THEN it commits as always, and the failure is logged once per file with its path and errno
-  EXPECT_EQ(r.rig.status().state, CalibrationState::kDone) << r.rig.status().reason;
-  EXPECT_FALSE(r.rig.previous_calibration_intact());
+  // THEN it stops at its first failed write, before it moves, naming the path and errno; nothing is committed
+  EXPECT_EQ(r.rig.status().state, CalibrationState::kFailed) << r.rig.status().reason;
+  EXPECT_TRUE(contains(r.rig.status().reason, "store: open " + r.entry(1) + "/.robot.toml.tmp: Not a directory"))
+      << r.rig.status().reason;
+  EXPECT_TRUE(r.rig.previous_calibration_intact());
+  EXPECT_EQ(r.rig.status().samples, 0);
+  EXPECT_TRUE(r.rig.winches.all_stopped());
+  // AND the failure is logged once per file with its path and errno
   const std::string log = joined(r.messages);
   EXPECT_TRUE(contains(log, r.entry(1) + "/.samples.csv.tmp: Not a directory")) << log;
   EXPECT_TRUE(contains(log, r.entry(1) + "/.run.toml.tmp: Not a directory")) << log;
