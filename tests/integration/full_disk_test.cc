@@ -79,8 +79,8 @@ class SmallDisk {
 calibctl::JsonValue poll_until(const VirtualRobotProcess& rig, const std::function<bool(const calibctl::JsonValue&)>& done,
                                std::chrono::seconds timeout) {
   calibctl::JsonValue status;
-  const auto end = Clock::now() + timeout;
-  while (Clock::now() < end) {
+  const RobotDeadline end(rig.robot_clock(), timeout);
+  while (!end.passed()) {
     status = rig.ask("status");
     if (done(status)) return status;
     std::this_thread::sleep_for(10ms);
@@ -88,22 +88,23 @@ calibctl::JsonValue poll_until(const VirtualRobotProcess& rig, const std::functi
   return status;
 }
 
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
+// Seconds of the robot's time since `start_us` on its clock.
+double seconds_since(const VirtualRobotProcess& rig, hal::TimeUs start_us) {
+  return 1e-3 * robot_ms_since(rig.robot_clock(), start_us);
 }
 
 // The run's end after the disk is filled now: it must fail for want of space.
 struct AfterFill {
   calibctl::JsonValue end;
-  double seconds = 0.0;  // from the fill to the failed state seen
+  double seconds = 0.0;  // from the fill to the failed state seen, in the robot's time
   std::string reason;
 };
 AfterFill fill_and_wait_for_end(const VirtualRobotProcess& rig, const SmallDisk& disk) {
-  const auto filled = Clock::now();
+  const hal::TimeUs filled_us = rig.robot_clock().now_us();
   disk.fill();
   AfterFill after;
   after.end = rig.wait_for_end(slowed(120s));
-  after.seconds = seconds_since(filled);
+  after.seconds = seconds_since(rig, filled_us);
   after.reason = after.end["reason"].string();
   EXPECT_EQ(after.end["state"].string(), "failed") << after.reason;
   EXPECT_TRUE(contains(after.reason, "No space left on device")) << after.reason;
@@ -194,7 +195,7 @@ TEST(FullDisk, AtTheCommitTheFitIsKeptAndCommittedOnceSpaceIsBack) {
   // WHEN the disk fills while the run solves (after its last sample, before its commit)
   ASSERT_TRUE(rig.ask("start")["ok"].boolean());
   // (asked slowly until the last waypoint: the virtual robot shares the CPU)
-  wait_until(
+  rig.wait_until_robot(
       [&] {
         const calibctl::JsonValue s = rig.ask("status");
         return s["waypoint"].integer() >= 12 || !s["running"].boolean();
