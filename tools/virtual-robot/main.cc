@@ -75,6 +75,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(-0.9, 10.0));
   CLI11_PARSE(app, argc, argv);
   options.preset = *cdpr::sim::parse_preset(preset);
+  options.report_stops = true;  // a line per stop: how far the platform swung (docs/fieldbus.md)
   options.modbus_rtu = transport == "rtu";
   options.load_cell.model = *cdpr::virtual_robot::parse_load_cell_model(model);
   options.load_cell.reply_latency_us = static_cast<cdpr::hal::TimeUs>(latency_ms * 1000.0);
