@@ -94,6 +94,12 @@ int main(int argc, char** argv) {
               (*robot)->modbus_endpoint().c_str(), (*robot)->pose_endpoint().c_str());
   std::fflush(stdout);
   (*robot)->run(g_stop);
+  if (const auto& stop = (*robot)->stops().latest(); stop && !stop->settled && !stop->interrupted) {
+    std::printf("virtual-robot: stop at %.1f s (robot time), platform at %.2f m/s: platform up to %.2f m from where "
+                "the stop began (%.1f s after it), still swinging %.2f m from it at exit\n",
+                stop->began_s, stop->speed_mps, stop->largest_m, stop->largest_at_s - stop->began_s,
+                stop->from_start_m);
+  }
   std::printf("virtual-robot: stopped (%d equilibrium solves failed, %d with a slack cable; %.1f s of robot time "
               "not simulated while starved of CPU)\n",
               (*robot)->physics().failed_solves(), (*robot)->physics().slack_solves(), (*robot)->robot_time_lost_s());
