@@ -86,7 +86,8 @@ CanopenWinchBank::CanopenWinchBank(CanWinchBankConfig config, CanConnector conne
     w.error_code_steps = {{SdoStep::Kind::kRead, 0x603F, 0, 2, 0, "error code"}};
     w.profile_steps = {{SdoStep::Kind::kWrite, 0x6081, 0, 4, 0, "profile velocity"},
                        {SdoStep::Kind::kWrite, 0x6083, 0, 4, 0, "profile acceleration"},
-                       {SdoStep::Kind::kWrite, 0x6084, 0, 4, 0, "profile deceleration"}};
+                       {SdoStep::Kind::kWrite, 0x6084, 0, 4, 0, "profile deceleration"},
+                       {SdoStep::Kind::kWrite, 0x6085, 0, 4, 0, "quick stop deceleration"}};
     winches_.push_back(std::move(w));
   }
 }

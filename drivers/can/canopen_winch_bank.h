@@ -94,12 +94,15 @@ class CanopenWinchBank final : public hal::WinchBank {
   hal::Status enable() override;
   hal::Status disable() override;
   hal::Status set_target_payout(int winch, double payout_m) override;
-  // Coordinated: per move, each drive's profile velocity, acceleration and
-  // deceleration (0x6081, 0x6083, 0x6084) are the description's scaled by
-  // |delta_i| / max |delta|, written over SDO, and then all targets are
-  // sent in the same cycle: every winch runs a time-scaled copy of the
-  // longest winch's trapezoid, so all start and arrive together and the
-  // payouts move along the straight line between the two waypoints.
+  // Coordinated: per move, each drive's profile velocity, acceleration,
+  // deceleration and quick-stop deceleration (0x6081, 0x6083, 0x6084,
+  // 0x6085) are the description's scaled by |delta_i| / max |delta|
+  // (move_profile.h), written over SDO, and then all targets are sent in
+  // the same cycle: every winch runs a scaled copy of the longest winch's
+  // trapezoid, so all start and arrive together, and stop together on a
+  // halt, a quick stop or a lost master heartbeat, the payouts staying on
+  // the straight line between the two waypoints. A profile any drive
+  // refuses moves none of them (that winch's latched fault says why).
   hal::Status set_target_payouts(const double* payouts_m) override;
   hal::Status halt() override;
   hal::Status quick_stop() override;
@@ -128,7 +131,7 @@ class CanopenWinchBank final : public hal::WinchBank {
     double target_payout_m = 0.0;
     EnableStep enable = EnableStep::kNone;
     bool mode_check_started = false;
-    std::vector<SdoStep> profile_steps;  // this move's 0x6081/0x6083/0x6084
+    std::vector<SdoStep> profile_steps;  // this move's 0x6081/0x6083/0x6084/0x6085
     bool profile_pending = false;       // written before the coordinated target goes out
     std::int32_t pending_target_counts = 0;
     std::string fault;  // latched: configuration refused or mismatched, encoder jump

@@ -2,6 +2,7 @@
 // and coordinated moves whose profile velocities make every winch arrive
 // together. Bus supervision and status live in canopen_winch_bank.cc.
 #include "drivers/can/canopen_winch_bank.h"
+#include "drivers/can/move_profile.h"
 
 #include <algorithm>
 #include <cmath>
@@ -117,18 +118,15 @@ hal::Status CanopenWinchBank::set_target_payouts(const double* payouts_m) {
     w.pending_target_counts = target.value();
     longest_m = std::max(longest_m, std::abs(payouts_m[i] - status(i).payout_m));
   }
-  const DriveDescription& d = config_.drive;
   for (int i = 0; i < winch_count(); ++i) {
     Winch& w = winches_[static_cast<std::size_t>(i)];
     const double share = longest_m > 0.0 ? std::abs(payouts_m[i] - status(i).payout_m) / longest_m : 1.0;
-    const double m_per_count = std::abs(config_.winches[static_cast<std::size_t>(i)].drive_m_per_count);
-    // At least one count per second (and per s^2): CiA 402 drives refuse 0.
-    const auto scaled = [&](double per_s) {
-      return static_cast<std::uint32_t>(std::max(1.0, std::round(share * per_s / m_per_count)));
-    };
-    w.profile_steps[0].value = scaled(d.profile_velocity_mps);
-    w.profile_steps[1].value = scaled(d.profile_acceleration_mps2);
-    w.profile_steps[2].value = scaled(d.profile_deceleration_mps2);
+    const MoveProfileCounts p =
+        scaled_move_profile(config_.drive, share, config_.winches[static_cast<std::size_t>(i)].drive_m_per_count);
+    w.profile_steps[0].value = p.velocity;
+    w.profile_steps[1].value = p.acceleration;
+    w.profile_steps[2].value = p.deceleration;
+    w.profile_steps[3].value = p.quick_stop_deceleration;
     w.profile_pending = true;
     w.drive_node.configurator.start(&w.profile_steps);
     w.target_payout_m = payouts_m[i];
@@ -151,7 +149,7 @@ hal::Status CanopenWinchBank::service_coordinated_move(hal::TimeUs now_us) {
     if (c.state() == NodeConfigurator::State::kDone) {
       w.profile_pending = false;
     } else if (c.state() == NodeConfigurator::State::kFailed || c.state() == NodeConfigurator::State::kNoAnswer) {
-      if (w.fault.empty()) w.fault = "move profile refused: " + c.error();
+      if (w.fault.empty()) w.fault = "move profile refused, no winch moved: " + c.error();
       w.profile_pending = false;
     } else {
       all_written = false;
@@ -159,9 +157,13 @@ hal::Status CanopenWinchBank::service_coordinated_move(hal::TimeUs now_us) {
   }
   if (!all_written) return first_error;
   coordinated_move_pending_ = false;
-  // Every profile is in place: the targets go out in this one cycle.
-  for (Winch& w : winches_) {
-    if (w.fault.empty()) w.drive.command_target(w.pending_target_counts);
+  // A winch whose profile was refused (or that faulted meanwhile) would
+  // leave the others pulling the platform off the line alone: none moves.
+  // The refusal is that winch's latched fault (status().fault).
+  const bool refused = std::any_of(winches_.begin(), winches_.end(), [](const Winch& w) { return !w.fault.empty(); });
+  if (!refused) {
+    // Every profile is in place: the targets go out in this one cycle.
+    for (Winch& w : winches_) w.drive.command_target(w.pending_target_counts);
   }
   if (hal::Status s = poll_drives(now_us); !s.ok() && first_error.ok()) first_error = s;
   return first_error;

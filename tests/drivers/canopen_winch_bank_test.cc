@@ -9,6 +9,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <memory>
 
 #include <gtest/gtest.h>
@@ -178,6 +180,79 @@ TEST_F(CanopenWinchBankTest, CoordinatedMoveStartsAndArrivesTogether) {
   EXPECT_TRUE(bank_->motion_finished());
   EXPECT_NEAR(bank_->status(0).payout_m, targets_m[0], kEncoderMPerCount);
   EXPECT_NEAR(bank_->status(1).payout_m, targets_m[1], kEncoderMPerCount);
+}
+
+TEST_F(CanopenWinchBankTest, RefusedMoveProfileMovesNoWinch) {
+  // GIVEN enabled drives, winch 1's drive refusing a new profile acceleration (0x6083 read-only)
+  start();
+  open_and_enable();
+  bus_->drive(1).od().find(0x6083, 0)->access = virtual_robot::Access::kReadOnly;
+  const double start0_m = bank_->status(0).payout_m, start1_m = bank_->status(1).payout_m;
+  // WHEN winch 0 is sent 0.8 m and winch 1 0.2 m in one coordinated move
+  const double targets_m[2] = {start0_m + 0.8, start1_m - 0.2};
+  ASSERT_TRUE(bank_->set_target_payouts(targets_m).ok());
+  run_ms(400);
+  // THEN winch 1 has a fault naming the refusal, and neither winch moved
+  EXPECT_TRUE(bank_->status(1).fault);
+  EXPECT_NE(bank_->fault_text(1).find("move profile refused, no winch moved: node 2 SDO write 0x6083"),
+            std::string::npos)
+      << bank_->fault_text(1);
+  EXPECT_NEAR(bank_->status(0).payout_m, start0_m, kEncoderMPerCount);
+  EXPECT_NEAR(bank_->status(1).payout_m, start1_m, kEncoderMPerCount);
+  EXPECT_TRUE(bus_->drive(0).at_rest());
+}
+
+// Where a coordinated move's payouts are after a stop: how far the drives'
+// stop times spread and how far the payouts left the move's straight line
+// (the distance in payout space, as a fraction of the move's length).
+struct StopOnTheLine {
+  double stop_spread_s = 0.0;
+  double off_line_fraction = 0.0;
+};
+
+TEST_F(CanopenWinchBankTest, HeartbeatLossStopsEveryWinchAlongTheCommandedLine) {
+  // GIVEN enabled drives whose quick stop brakes at 8 m/s^2 (0.5 s from the profile's 4 m/s)
+  CanWinchBankConfig config = two_winches();
+  config.drive.quick_stop_deceleration_mps2 = 8.0;
+  start(config);
+  open_and_enable();
+  // AND a coordinated move of 8 m on winch 0 and 2 m on winch 1 (a quarter of the speed)
+  const double delta_m[2] = {8.0, -2.0};
+  const double start_counts[2] = {bus_->drive(0).position_counts(), bus_->drive(1).position_counts()};
+  const double targets_m[2] = {bank_->status(0).payout_m + delta_m[0], bank_->status(1).payout_m + delta_m[1]};
+  ASSERT_TRUE(bank_->set_target_payouts(targets_m).ok());
+  run_ms(300);
+  ASSERT_GT(std::abs(bus_->drive(0).demand_counts() - start_counts[0]) * kDriveMPerCount, 0.5);
+  // WHEN the master falls silent mid-move and the drives quick-stop on their own
+  StopOnTheLine result;
+  double stopped_s[2] = {-1.0, -1.0};
+  const double length_m = std::hypot(delta_m[0], delta_m[1]);
+  for (int t_ms = 0; t_ms < 2000; t_ms += 5) {
+    run_ms(5, false);
+    double along_m = 0.0, moved_m[2];
+    for (int i = 0; i < 2; ++i) {
+      moved_m[i] = (bus_->drive(i).position_counts() - start_counts[i]) * kDriveMPerCount;
+      along_m += moved_m[i] * delta_m[i] / length_m;
+      if (stopped_s[i] < 0.0 && bus_->drive(i).at_rest()) stopped_s[i] = 1e-3 * (t_ms + 5);
+    }
+    const double off_m = std::hypot(moved_m[0] - along_m * delta_m[0] / length_m, moved_m[1] - along_m * delta_m[1] / length_m);
+    result.off_line_fraction = std::max(result.off_line_fraction, off_m / length_m);
+  }
+  ASSERT_GT(stopped_s[0], 0.0);
+  ASSERT_GT(stopped_s[1], 0.0);
+  result.stop_spread_s = std::abs(stopped_s[0] - stopped_s[1]);
+  std::printf("heartbeat loss mid-move: drives stopped %.3f s and %.3f s after the master's silence (spread %.3f s), "
+              "payouts at most %.4f of the move's length off its line\n",
+              stopped_s[0], stopped_s[1], result.stop_spread_s, result.off_line_fraction);
+  // THEN both stopped short of the targets in quick stop, at the same moment
+  // (one 5 ms step), and the payouts never left the line by more than 0.1 %
+  // of the move (with one 0x6085 for both: 0.375 s apart and 2 % off)
+  EXPECT_EQ(bus_->drive(0).statusword() & 0x006F, 0x0007);
+  EXPECT_EQ(bus_->drive(1).statusword() & 0x006F, 0x0007);
+  EXPECT_LT(std::abs(bus_->drive(0).position_counts() - start_counts[0]) * kDriveMPerCount, 6.0);
+  EXPECT_LE(result.stop_spread_s, 0.005 + 1e-9);
+  EXPECT_LT(result.off_line_fraction, 0.001);
+  EXPECT_EQ(bus_->drive(1).od().get(0x6085, 0), bus_->drive(0).od().get(0x6085, 0) / 4);
 }
 
 TEST_F(CanopenWinchBankTest, DriveLeftInHomingModeIsSwitchedToProfilePosition) {

@@ -16,10 +16,10 @@ namespace cdpr::integration {
 constexpr double kProfileVelocityMps = 2.0, kProfileAccelerationMps2 = 1.0;
 
 inline void sdo_write(virtual_robot::Cia402Device& d, std::uint16_t index, std::uint32_t value, int size,
-                      hal::TimeUs now_us) {
+                      hal::TimeUs now_us, std::uint8_t subindex = 0) {
   virtual_robot::BusFrame f{0x600 + static_cast<std::uint32_t>(d.node_id()), 8, {}};
   f.data = {static_cast<std::uint8_t>(0x23 | (4 - size) << 2), static_cast<std::uint8_t>(index),
-            static_cast<std::uint8_t>(index >> 8), 0, static_cast<std::uint8_t>(value),
+            static_cast<std::uint8_t>(index >> 8), subindex, static_cast<std::uint8_t>(value),
             static_cast<std::uint8_t>(value >> 8), static_cast<std::uint8_t>(value >> 16),
             static_cast<std::uint8_t>(value >> 24)};
   d.on_frame(f, now_us);

@@ -53,6 +53,20 @@ bool CanopenNodes::winches_still() const {
   return true;
 }
 
+bool CanopenNodes::any_drive_braking() const {
+  for (const auto& d : drives_) {
+    if (d->braking()) return true;
+  }
+  return false;
+}
+
+bool CanopenNodes::axes_still() const {
+  for (const auto& d : drives_) {
+    if (!d->axis_still()) return false;
+  }
+  return true;
+}
+
 void CanopenNodes::poll(hal::TimeUs now_us, std::vector<drivers::can::CanFrame>& out) {
   scratch_.clear();
   for (int i = 0; i < kCableCount; ++i) {

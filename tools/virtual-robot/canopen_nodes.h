@@ -53,6 +53,10 @@ class CanopenNodes {
   void silence(int node_id, bool silent);
   // Every drive at rest (no profile running).
   bool winches_still() const;
+  // A drive is braking to rest on a stop (Cia402Device::braking()).
+  bool any_drive_braking() const;
+  // Every motor still (Cia402Device::axis_still()): no move running or a halted one.
+  bool axes_still() const;
   Cia402Device& drive(int winch) { return *drives_[winch]; }
   Cia406Device& encoder(int winch) { return *encoders_[winch]; }
 

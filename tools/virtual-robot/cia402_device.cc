@@ -58,6 +58,12 @@ Cia402Device::Cia402Device(int node_id, const DriveDefaults& defaults)
 
 bool Cia402Device::operation_enabled() const { return power_ == Power::kOperationEnabled; }
 
+bool Cia402Device::braking() const {
+  if (velocity_ == 0.0) return false;
+  return power_ == Power::kQuickStopActive || power_ == Power::kFaultReaction ||
+         (power_ == Power::kOperationEnabled && (last_controlword_ & kBitHalt) != 0);
+}
+
 void Cia402Device::on_reset() {
   power_ = Power::kSwitchOnDisabled;
   last_controlword_ = 0;

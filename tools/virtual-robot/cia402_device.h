@@ -55,6 +55,10 @@ class Cia402Device final : public CanopenDevice {
   void set_initial_position(double counts) { actual_ = demand_ = target_ = counts; }
   // No profile running and the motor still.
   bool at_rest() const { return velocity_ == 0.0 && !moving_ && demand_ == actual_; }
+  // The motor still (velocity 0 and where the profile wants it), also while halted mid-move.
+  bool axis_still() const { return velocity_ == 0.0 && demand_ == actual_; }
+  // Braking to rest on a stop (quick stop, fault reaction, or halt bit 8) and still moving.
+  bool braking() const;
   // The axis held still (brake, blocked winch) or released: for following errors.
   void set_blocked(bool blocked) { blocked_ = blocked; }
   // For tests and the robot: where the drive is heading, and its power state name.

@@ -76,6 +76,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(-0.9, 10.0));
   CLI11_PARSE(app, argc, argv);
   options.preset = *cdpr::sim::parse_preset(preset);
+  options.report_stops = true;  // a line per stop: how far the platform swung (docs/fieldbus.md)
   options.modbus_rtu = transport == "rtu";
   options.load_cell.model = *cdpr::virtual_robot::parse_load_cell_model(model);
   options.load_cell.reply_latency_us = static_cast<cdpr::hal::TimeUs>(latency_ms * 1000.0);
@@ -94,6 +95,12 @@ int main(int argc, char** argv) {
               (*robot)->modbus_endpoint().c_str(), (*robot)->pose_endpoint().c_str());
   std::fflush(stdout);
   (*robot)->run(g_stop);
+  if (const auto& stop = (*robot)->stops().latest(); stop && !stop->settled && !stop->interrupted) {
+    std::printf("virtual-robot: stop at %.1f s (robot time), platform at %.2f m/s: platform up to %.2f m from where "
+                "the stop began (%.1f s after it), still swinging %.2f m from it at exit\n",
+                stop->began_s, stop->speed_mps, stop->largest_m, stop->largest_at_s - stop->began_s,
+                stop->from_start_m);
+  }
   cdpr::hal::TimeUs heartbeat_gap_us = 0;
   for (int winch = 0; winch < cdpr::kCableCount; ++winch) {
     heartbeat_gap_us = std::max(heartbeat_gap_us, (*robot)->nodes().drive(winch).longest_consumer_gap_us());

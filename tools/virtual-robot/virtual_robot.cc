@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 
 #include "drivers/can/fd_can_transport.h"
@@ -153,6 +154,18 @@ void VirtualRobot::advance(double dt_s) {
   for (int k = 0; k < steps; ++k) {
     nodes_->advance(dt_s / steps);
     physics_->advance(dt_s / steps);
+    watched_s_ += dt_s / steps;
+    const Eigen::Vector3d& platform = physics_->pose().position_world;
+    stops_.step(watched_s_, nodes_->any_drive_braking(), nodes_->axes_still(), platform,
+                physics_->velocity_mps().norm(), (platform - physics_->rest().world_T_platform.position_world).norm());
+  }
+  if (options_.report_stops && stops_.take_finished()) {
+    const StopReport& r = *stops_.latest();
+    std::printf("virtual-robot: stop at %.1f s (robot time), platform at %.2f m/s: cables at rest after %.2f s, "
+                "platform up to %.2f m from where the stop began (%.1f s after it), %s %.2f m from it after %.1f s\n",
+                r.began_s, r.speed_mps, r.cables_stopped_s - r.began_s, r.largest_m, r.largest_at_s - r.began_s,
+                r.settled ? "at rest" : "still swinging at the next move,", r.from_start_m, watched_s_ - r.began_s);
+    std::fflush(stdout);
   }
 }
 

@@ -53,6 +53,7 @@
 #include "virtual-robot/modbus_transport.h"
 #include "virtual-robot/virtual_load_cell.h"
 #include "virtual-robot/robot_physics.h"
+#include "virtual-robot/stop_excursion.h"
 #include "virtual-robot/stream_listener.h"
 
 namespace cdpr::virtual_robot {
@@ -77,6 +78,9 @@ struct VirtualRobotOptions {
   // tension + force_bias_n. Other effects change the physics the same way as
   // in cdpr-sim.
   sim::HiddenEffects effects;
+  // Print a line to stdout when the platform came to rest after a stop
+  // (stop_excursion.h: its largest excursion, where it rests).
+  bool report_stops = false;
 };
 
 // The simulated data set behind a virtual robot made with `options` (the
@@ -116,6 +120,8 @@ class VirtualRobot {
   const Robot& nominal_robot() const { return data_.nominal; }
   const Truth& truth() const { return data_.truth; }
   const RobotPhysics& physics() const { return *physics_; }
+  // The platform after the latest stop (stop_excursion.h), watched in advance().
+  const StopExcursion& stops() const { return stops_; }
   // Winch i's payout [m] as of the last run_once(), readable from any thread.
   double payout_snapshot_m(int winch) const { return payout_snapshot_m_[winch].load(); }
   CanopenNodes& nodes() { return *nodes_; }
@@ -151,6 +157,8 @@ class VirtualRobot {
   sim::Rng noise_;
   std::unique_ptr<RobotPhysics> physics_;
   std::unique_ptr<CanopenNodes> nodes_;
+  StopExcursion stops_;
+  double watched_s_ = 0.0;  // robot time advance() has simulated
   std::unique_ptr<StreamListener> can_;
   std::unique_ptr<StreamListener> pose_;
   std::unique_ptr<VirtualLoadCell> cell_;
