@@ -152,8 +152,11 @@ class Cia402Drive {
             const relative = (cw & 0x40) !== 0;
             const target = this.value(0x607A);
             this.target = relative ? this.target + target : target;
+            // A drive in rpm clamps the profile velocity to its max motor speed 0x6080.
+            const maxVelocity = this.options.rpm ? this.value(0x6080) * this.options.countsPerRev / 60 : Infinity;
             this.profile = {
-                velocity: this.rate(0x6081), acceleration: this.rate(0x6083), deceleration: this.rate(0x6084),
+                velocity: Math.min(this.rate(0x6081), maxVelocity),
+                acceleration: this.rate(0x6083), deceleration: this.rate(0x6084),
             };
             this.ack = true;
         } else if (!newSetpoint) {

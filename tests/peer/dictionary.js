@@ -30,7 +30,8 @@ function record(eds, index, name, subs) {
 // One PDO's communication and mapping records (CiA 301 7.5.2.35-38).
 // options.rtrFixed: COB-ID bit 30 reads 1 whatever is written (a device
 // without RTR, as the Lika manual requires); options.maxType: the highest
-// transmission type it takes (254 for a device without 255).
+// TPDO transmission type it takes (254 for a device without 255: a write of
+// 255 is refused with abort 0x06090031).
 function pdo(eds, transmit, number, cobId, mapped, options) {
     const comm = (transmit ? 0x1800 : 0x1400) + number - 1;
     const kind = transmit ? 'TPDO' : 'RPDO';
@@ -38,7 +39,7 @@ function pdo(eds, transmit, number, cobId, mapped, options) {
     const valid = mapped.length > 0 ? 0 : 0x80000000;
     const subs = [
         [1, 'COB-ID', DataType.UNSIGNED32, RW, (valid | rtrBit | cobId) >>> 0],
-        [2, 'transmission type', DataType.UNSIGNED8, RW, transmit ? 254 : 254, { highLimit: options.maxType }],
+        [2, 'transmission type', DataType.UNSIGNED8, RW, 254, transmit ? { highLimit: options.maxType } : {}],
     ];
     if (transmit) {
         subs.push([3, 'inhibit time', DataType.UNSIGNED16, RW, 0]);
