@@ -241,8 +241,11 @@ TEST_F(CanopenPeerTest, DrivesQuickStopWhenTheMasterIsKilled) {
   const double m_per_count = config.winches[0].drive_m_per_count;
   std::int32_t start_position = 0;
   bool started = false;
+  int master_status = 0;
+  bool master_ended = false;
   const bool at_speed = wait_until(
       [&] {
+        if (waitpid(master, &master_status, WNOHANG) == master) return master_ended = true;
         if (!bus.poll()) return false;
         const auto& d = bus.drives[1];
         if (!d.heard || !operation_enabled(d.statusword)) return false;
@@ -253,6 +256,10 @@ TEST_F(CanopenPeerTest, DrivesQuickStopWhenTheMasterIsKilled) {
         return std::abs(d.position - start_position) * m_per_count > 2.5;
       },
       30s);
+  if (master_ended) {
+    FAIL() << "the master process ended before the drives moved (exit status " << WEXITSTATUS(master_status)
+           << ": 2 enabling failed, 3 the move was refused; its messages are above); peer log:\n" << peer.log();
+  }
   if (!at_speed) {
     kill(master, SIGKILL);
     waitpid(master, nullptr, 0);
