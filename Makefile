@@ -23,13 +23,15 @@ export CMAKE_GENERATOR ?= Ninja
 BUILD_PACKAGES := build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev \
                   libmodbus-dev libsystemd-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev \
                   libgtest-dev libgmock-dev libgpiod-dev systemd ninja-build libseccomp-dev
-TEST_PACKAGES  := mbpoll bubblewrap lintian chromium tidy
+TEST_PACKAGES  := mbpoll bubblewrap lintian chromium tidy nodejs python3
 DEB_PACKAGES   := $(BUILD_PACKAGES) $(TEST_PACKAGES)
 # mbpoll: a Modbus master neither the daemon nor the virtual robot shares
 # code with, for the load cell's cross-check test. bubblewrap: the test that
 # runs the daemon in the unit's sandbox. lintian: the package test. chromium
 # and tidy: the tests that read the HTML reports in a headless browser and
-# check them as HTML5 (tools/check-report).
+# check them as HTML5 (tools/check-report). nodejs: runs the independent
+# CANopen peer (tests/peer, the npm package canopen; see peer-deps below);
+# python3: node-gyp builds canopen's CRC addon (node-crc) with it.
 # Ceres and Google Benchmark are used by the benchmark comparison only,
 # never linked into the daemon.
 BENCH_PACKAGES := libceres-dev libbenchmark-dev
@@ -40,7 +42,7 @@ FUZZ_BUILD   ?= $(BUILD)-fuzz
 FUZZ_SECONDS ?= 600
 FUZZ_TARGETS ?=
 
-.PHONY: all deps build-deps bench-deps configure check test sanitize fuzz demo demo-offline bench install deb docs clean
+.PHONY: all deps build-deps bench-deps peer-deps configure check test sanitize fuzz demo demo-offline bench install deb docs clean
 
 all: configure
 	cmake --build $(BUILD) -j $(JOBS)
@@ -65,15 +67,28 @@ check: deps configure
 	cmake --build $(BUILD) -j $(JOBS) --target unit_test_binaries
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -L '^unit$$'
 
+# The CANopen peer's npm package (tests/peer/package-lock.json pins it),
+# for the integration tests against a stack we did not write. Debian 12's
+# nodejs comes without npm, which is the Debian package npm; a nodejs from
+# elsewhere (NodeSource) brings its own npm and conflicts with Debian's, so
+# the package is installed only when the command is missing. Without the
+# registry the peer's tests skip and say why.
+PEER_DIR := tests/peer
+peer-deps: deps
+	@command -v npm >/dev/null || ./tools/install-deps.sh npm
+	@[ -f $(PEER_DIR)/node_modules/canopen/package.json ] || \
+	  (cd $(PEER_DIR) && npm ci --no-audit --no-fund) || \
+	  echo "peer-deps: npm could not install $(PEER_DIR)'s packages (registry unreachable?): the CANopen peer tests will skip"
+
 # Every test: unit, integration and slow.
-test: deps all
+test: deps peer-deps all
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
 # The whole test suite under AddressSanitizer and UndefinedBehaviorSanitizer
 # (any UB is fatal, leaks fail). Built cheaper than the normal build: -O1
 # -g1 and only the test binaries (no tools, no benchmarks). CI runs it.
 SANITIZE_BUILD ?= $(BUILD)-asan
-sanitize: deps
+sanitize: deps peer-deps
 	cmake -S . -B $(SANITIZE_BUILD) -DCMAKE_BUILD_TYPE= "-DCMAKE_CXX_FLAGS=-O1 -g1" "-DCMAKE_C_FLAGS=-O1 -g1" \
 	  -DCDPR_WERROR=ON -DCDPR_SANITIZE=ON
 	cmake --build $(SANITIZE_BUILD) -j $(JOBS) --target test_binaries

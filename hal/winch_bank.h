@@ -64,6 +64,27 @@ struct WinchStatus {
   bool fault = false;             // a fault latched by the bank (fault_text() says which)
 };
 
+// One bus node of a winch (its drive or its encoder) as the bank last heard
+// it, for the operator (calibctl status); nothing in the run decides on it.
+// The texts are static strings (no allocation); ages are now - last [us],
+// -1 when never heard.
+struct NodeStatus {
+  const char* role = "";             // "drive" or "encoder"
+  int node_id = 0;
+  const char* nmt = "unknown";       // NMT state of its heartbeat: "boot-up", "pre-operational",
+                                     // "operational", "stopped"; "silent" past the heartbeat timeout
+  bool configured = false;           // the master's configuration taken and verified
+  const char* power_state = "";      // drives: CiA 402 state ("operation enabled", "quick stop
+                                     // active", "fault", ...); "" for encoders or before a statusword
+  std::uint16_t error_code = 0;      // drives in fault: 0x603F as read (0: not read or none)
+  const char* error_text = "";       // its meaning
+  std::uint16_t emcy_code = 0;       // the last EMCY from this node (0: none since open)
+  std::uint8_t emcy_register = 0;    // its error register
+  const char* emcy_text = "";
+  TimeUs pdo_age_us = -1;            // since its last TPDO
+  TimeUs heartbeat_age_us = -1;      // since its last heartbeat
+};
+
 // Bus counters for diagnostics (PX4-style perf counters, no log per frame).
 struct WinchBankCounters {
   std::uint64_t frames_rx = 0;
@@ -100,6 +121,18 @@ class WinchBank {
   // when none. Allocates: for messages, not for the cyclic path.
   virtual std::string fault_text(int winch) const {
     (void)winch;
+    return {};
+  }
+
+  // The bus nodes of one winch (0 <= node < node_count(winch)), for the
+  // operator's status. Banks without nodes (fakes) have none.
+  virtual int node_count(int winch) const {
+    (void)winch;
+    return 0;
+  }
+  virtual NodeStatus node_status(int winch, int node) const {
+    (void)winch;
+    (void)node;
     return {};
   }
 

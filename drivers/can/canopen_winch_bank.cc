@@ -75,12 +75,22 @@ std::string validate(const CanWinchBankConfig& config) {
 }
 
 CanopenWinchBank::CanopenWinchBank(CanWinchBankConfig config, CanConnector connector)
-    : config_(std::move(config)), connector_(std::move(connector)), mode_steps_(drive_mode_check()) {
+    : config_(std::move(config)), connector_(std::move(connector)) {
+  // The mode check's write goes out once; its expected display value is
+  // read (not compared once) until the drive shows it.
+  for (const SdoStep& step : drive_mode_check()) {
+    if (step.kind != SdoStep::Kind::kExpect) {
+      mode_write_steps_.push_back(step);
+    } else {
+      mode_display_steps_.push_back({SdoStep::Kind::kRead, step.index, step.subindex, step.size, 0, step.what});
+      mode_wanted_ = step.value;
+    }
+  }
   winches_.reserve(config_.winches.size());
   for (const CanWinchConfig& c : config_.winches) {
     Winch w{Node(c.drive_node_id, config_.sdo_timeout_us), Node(c.encoder_node_id, config_.sdo_timeout_us),
             Cia402Drive(config_.resend_interval_us), EncoderUnwrap(), -1, 0.0, EnableStep::kNone, false, {}, false, 0,
-            {}, {}, {}, false, {}};
+            {}, {}, {}, false, {}, 0, 0, 0};
     w.drive_node.steps = drive_configuration(c.drive_node_id, config_.master_node_id, c.drive_m_per_count, config_.drive);
     if (c.encoder_node_id != 0) w.encoder_node.steps = encoder_configuration(c.encoder_node_id, config_.encoder);
     w.error_code_steps = {{SdoStep::Kind::kRead, 0x603F, 0, 2, 0, "error code"}};
@@ -119,6 +129,8 @@ hal::Status CanopenWinchBank::open() {
       node->configurator.cancel();
       node->configure_at_us = node->id != 0 ? now_us_ : -1;
       node->last_start_sent_us = -1;
+      node->emcy_code = 0;
+      node->emcy_register = 0;
     }
   }
   // Configuration starts from update(), one SDO frame per node per call.
@@ -220,13 +232,15 @@ void CanopenWinchBank::dispatch(const CanFrame& frame, hal::TimeUs now_us) {
   ++counters_.frames_ignored;  // our own frames echoed, other nodes, SYNC, ...
 }
 
-void CanopenWinchBank::on_emergency(Winch& w, const Node& node, const CanFrame& frame) {
+void CanopenWinchBank::on_emergency(Winch& w, Node& node, const CanFrame& frame) {
   if (frame.len < 3) {
     ++counters_.errors;
     return;
   }
   const auto code = static_cast<std::uint16_t>(frame.data[0] | frame.data[1] << 8);
   if (code == 0) return;  // error reset: the cause stays in the message until the next EMCY
+  node.emcy_code = code;
+  node.emcy_register = frame.data[2];
   char text[96];
   std::snprintf(text, sizeof(text), "EMCY 0x%04X (%s), error register 0x%02X from node %d", code,
                 emergency_text(code), frame.data[2], node.id);
@@ -325,6 +339,7 @@ hal::Status CanopenWinchBank::service_node(Winch& w, Node& node, hal::TimeUs now
 hal::Status CanopenWinchBank::service_error_code(Winch& w, hal::TimeUs now_us) {
   if (w.drive.drive_state() != hal::DriveState::kFault) {
     w.error_code_asked = false;
+    w.error_code_value = 0;
     if (!w.error_code.empty()) w.error_code.clear();
     return hal::Status::Ok();
   }
@@ -339,6 +354,7 @@ hal::Status CanopenWinchBank::service_error_code(Winch& w, hal::TimeUs now_us) {
   std::optional<CanFrame> frame = c.poll(now_us);
   if (c.state() == NodeConfigurator::State::kDone) {
     const std::uint32_t code = c.read_value(0x603F, 0).value_or(0);
+    w.error_code_value = static_cast<std::uint16_t>(code);
     char text[80];
     std::snprintf(text, sizeof(text), "0x603F = 0x%04X (%s)", static_cast<unsigned>(code),
                   emergency_text(static_cast<std::uint16_t>(code)));
@@ -348,23 +364,49 @@ hal::Status CanopenWinchBank::service_error_code(Winch& w, hal::TimeUs now_us) {
 }
 
 hal::Status CanopenWinchBank::service_enable(Winch& w, hal::TimeUs now_us) {
-  if (w.enable != EnableStep::kCheckMode || !w.drive_node.configured) return hal::Status::Ok();
+  const bool writing = w.enable == EnableStep::kCheckMode;
+  if ((!writing && w.enable != EnableStep::kAwaitMode) || !w.drive_node.configured) return hal::Status::Ok();
   if (!w.fault.empty()) {
     w.enable = EnableStep::kNone;
     return hal::Status::Ok();
   }
   NodeConfigurator& c = w.drive_node.configurator;
   if (!w.mode_check_started) {
+    if (!writing && now_us < w.mode_read_at_us) return hal::Status::Ok();
+    if (c.state() == NodeConfigurator::State::kRunning) return hal::Status::Ok();  // the channel is busy
     w.mode_check_started = true;
-    c.start(&mode_steps_);
+    c.start(writing ? &mode_write_steps_ : &mode_display_steps_);
   }
   std::optional<CanFrame> frame = c.poll(now_us);
   switch (c.state()) {
-    case NodeConfigurator::State::kDone:
-      w.enable = EnableStep::kGoalSet;
-      w.drive.set_goal(Cia402Drive::Goal::kEnabled);
+    case NodeConfigurator::State::kDone: {
+      w.mode_check_started = false;
+      if (writing) {
+        w.enable = EnableStep::kAwaitMode;
+        w.mode_deadline_us = now_us + config_.mode_switch_timeout_us;
+        w.mode_read_at_us = now_us;
+        break;
+      }
+      const SdoStep& display = mode_display_steps_[0];
+      const std::uint32_t shown = c.read_value(display.index, display.subindex).value_or(0);
+      if (shown == mode_wanted_) {
+        w.enable = EnableStep::kGoalSet;
+        w.drive.set_goal(Cia402Drive::Goal::kEnabled);
+      } else if (now_us >= w.mode_deadline_us) {
+        char text[200];
+        std::snprintf(text, sizeof(text),
+                      "enable refused: node %d: 0x%04X (%s) still %u %lld ms after the mode was written, expected %u",
+                      w.drive_node.id, display.index, display.what, shown,
+                      static_cast<long long>(config_.mode_switch_timeout_us / 1000), mode_wanted_);
+        w.fault = text;
+        w.enable = EnableStep::kNone;
+      } else {
+        w.mode_read_at_us = now_us + config_.mode_poll_interval_us;  // the drive is still switching
+      }
       break;
+    }
     case NodeConfigurator::State::kFailed:
+      w.mode_check_started = false;
       w.fault = "enable refused: " + c.error();
       w.enable = EnableStep::kNone;
       break;

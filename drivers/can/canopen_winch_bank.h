@@ -11,7 +11,7 @@
 // A node that does not answer is tried again every resend interval; a
 // refusal or a read-back mismatch is a latched fault naming node, object
 // and values, and the drive is never enabled. Before every enable the
-// drive's mode is written (0x6060 = 1) and checked (0x6061).
+// drive's mode is written (0x6060 = 1) and 0x6061 read until it shows it.
 // The master produces its own heartbeat (0x700 + master_node_id) every
 // master_heartbeat_us; the drives' consumer heartbeat (0x1016) makes them
 // stop on their own when the master goes silent.
@@ -66,6 +66,11 @@ struct CanWinchBankConfig {
   int master_node_id = 127;       // the heartbeat COB-ID 0x700 + this, and the drives' 0x1016 producer
   hal::TimeUs master_heartbeat_us = 100'000;
   hal::TimeUs sdo_timeout_us = 200'000;
+  // How long a drive may take to show the written mode in 0x6061 (CiA 402
+  // 6.2.7: the display follows when the mode has taken effect), read every
+  // mode_poll_interval_us meanwhile.
+  hal::TimeUs mode_switch_timeout_us = 1'000'000;
+  hal::TimeUs mode_poll_interval_us = 10'000;
   DriveDescription drive;
   EncoderDescription encoder;
 };
@@ -90,6 +95,9 @@ class CanopenWinchBank final : public hal::WinchBank {
   hal::WinchStatus status(int winch) const override;
   std::string fault_text(int winch) const override;
   hal::WinchBankCounters counters() const override { return counters_; }
+  // Drive first, then the encoder (when the winch has one).
+  int node_count(int winch) const override;
+  hal::NodeStatus node_status(int winch, int node) const override;
   hal::Status reset_faults() override;
   hal::Status enable() override;
   hal::Status disable() override;
@@ -120,8 +128,12 @@ class CanopenWinchBank final : public hal::WinchBank {
     NodeConfigurator configurator;
     std::vector<SdoStep> steps;
     hal::TimeUs last_start_sent_us = -1;
+    std::uint16_t emcy_code = 0;  // its last EMCY, for the operator's status
+    std::uint8_t emcy_register = 0;
   };
-  enum class EnableStep { kNone, kCheckMode, kGoalSet };
+  // kCheckMode: 0x6060 written; kAwaitMode: 0x6061 read until it shows the
+  // mode (drives switch asynchronously) or mode_switch_timeout_us passes.
+  enum class EnableStep { kNone, kCheckMode, kAwaitMode, kGoalSet };
   struct Winch {
     Node drive_node;
     Node encoder_node;  // id 0: none
@@ -139,13 +151,16 @@ class CanopenWinchBank final : public hal::WinchBank {
     std::vector<SdoStep> error_code_steps;  // 0x603F, read once per drive fault
     bool error_code_asked = false;
     std::string error_code;  // "0x603F = 0x8611 (following error)" of the present fault
+    hal::TimeUs mode_deadline_us = 0;  // kAwaitMode: give up after this
+    hal::TimeUs mode_read_at_us = 0;   // kAwaitMode: the next read of 0x6061
+    std::uint16_t error_code_value = 0;  // 0x603F of the present fault as read
   };
 
   hal::Status send(const CanFrame& frame);
   void dispatch(const CanFrame& frame, hal::TimeUs now_us);
   void on_position(Winch& winch, std::uint32_t raw, hal::TimeUs now_us);
   void on_heartbeat(Winch& winch, Node& node, NmtState state, hal::TimeUs now_us);
-  void on_emergency(Winch& winch, const Node& node, const CanFrame& frame);
+  void on_emergency(Winch& winch, Node& node, const CanFrame& frame);
   hal::Status service_node(Winch& winch, Node& node, hal::TimeUs now_us);
   hal::Status service_enable(Winch& winch, hal::TimeUs now_us);
   hal::Status service_coordinated_move(hal::TimeUs now_us);
@@ -167,7 +182,9 @@ class CanopenWinchBank final : public hal::WinchBank {
   CanConnector connector_;
   std::unique_ptr<CanTransport> transport_;
   std::vector<Winch> winches_;
-  std::vector<SdoStep> mode_steps_;
+  std::vector<SdoStep> mode_write_steps_;    // 0x6060 written
+  std::vector<SdoStep> mode_display_steps_;  // 0x6061 read
+  std::uint32_t mode_wanted_ = 0;            // what 0x6061 must show
   bool coordinated_move_pending_ = false;
   hal::TimeUs now_us_ = 0;
   hal::TimeUs last_master_heartbeat_us_ = -1;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "hal/clock.h"
+#include "hal/winch_bank.h"
 
 namespace cdpr::calibration {
 
@@ -45,6 +46,13 @@ struct CalibrationStatus {
   // Latched device faults and their causes ("winch 0: node 11: position
   // jumped ..."; EMCY codes), until `reset-faults` or a run's enable.
   std::string device_faults;
+  // Every bus node of the winches as last heard (NMT and CiA 402 state,
+  // 0x603F, last EMCY, PDO age), refreshed every step; for the operator.
+  struct Node {
+    int winch = 0;
+    hal::NodeStatus status;
+  };
+  std::vector<Node> nodes;
   int committed_seq = 0;       // store sequence number committed by the last run; 0 if none
   hal::TimeUs started_us = -1;        // monotonic start of the last run; -1 never
   hal::TimeUs state_entered_us = -1;  // when the current state was entered

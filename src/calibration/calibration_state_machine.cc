@@ -131,6 +131,17 @@ void CalibrationStateMachine::refresh_device_faults() {
   if (faults != status_.device_faults) status_.device_faults = std::move(faults);
 }
 
+void CalibrationStateMachine::refresh_nodes() {
+  std::size_t n = 0;
+  for (int i = 0; i < devices_.winches.winch_count(); ++i) {
+    for (int k = 0; k < devices_.winches.node_count(i); ++k, ++n) {
+      if (status_.nodes.size() <= n) status_.nodes.emplace_back();
+      status_.nodes[n] = {i, devices_.winches.node_status(i, k)};
+    }
+  }
+  status_.nodes.resize(n);
+}
+
 bool CalibrationStateMachine::request_abort(hal::TimeUs now_us, const std::string& why) {
   if (!is_running(status_.state)) {
     status_.note = "abort ignored: no calibration running";
@@ -243,6 +254,7 @@ void CalibrationStateMachine::poll_button(hal::TimeUs now_us) {
 void CalibrationStateMachine::step(hal::TimeUs now_us) {
   poll_button(now_us);
   refresh_device_faults();
+  refresh_nodes();
   const CalibrationState state = status_.state;
   if (state == CalibrationState::kPreflight && !store_probed_) {
     // Before anything moves, and before the run's first own write (its

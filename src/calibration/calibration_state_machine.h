@@ -226,6 +226,8 @@ class CalibrationStateMachine {
   void poll_button(hal::TimeUs now_us);
   // status().device_faults from the winch bank's latched faults.
   void refresh_device_faults();
+  // status().nodes from the winch bank (sized once; no allocation after).
+  void refresh_nodes();
   void run_preflight(hal::TimeUs now_us);
   void run_plan(hal::TimeUs now_us);
   // Commands the drives on, then waits for them (enable_timeout_us) and moves on.

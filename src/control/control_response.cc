@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include <Eigen/Core>
@@ -105,6 +106,36 @@ void add_waypoint_progress(const calibration::CalibrationStatus& status, hal::Ti
   }
 }
 
+// "0x8130 (life guard or heartbeat error)"; "" for code 0.
+std::string code_text(std::uint16_t code, const char* meaning) {
+  if (code == 0) return {};
+  char text[96];
+  std::snprintf(text, sizeof(text), "0x%04X (%s)", static_cast<unsigned>(code), meaning);
+  return text;
+}
+
+Json age_ms(hal::TimeUs age_us) { return age_us < 0 ? Json(nullptr) : Json(1e-3 * static_cast<double>(age_us)); }
+
+Json nodes_json(const std::vector<calibration::CalibrationStatus::Node>& nodes) {
+  Json array = Json::array();
+  for (const auto& [winch, n] : nodes) {
+    Json node;
+    node["winch"] = winch;
+    node["role"] = n.role;
+    node["node_id"] = n.node_id;
+    node["nmt"] = n.nmt;
+    node["configured"] = n.configured;
+    node["cia402"] = n.power_state;
+    node["error_code"] = code_text(n.error_code, n.error_text);
+    node["last_emcy"] = code_text(n.emcy_code, n.emcy_text);
+    node["emcy_register"] = n.emcy_register;
+    node["pdo_age_ms"] = age_ms(n.pdo_age_us);
+    node["heartbeat_age_ms"] = age_ms(n.heartbeat_age_us);
+    array.push_back(std::move(node));
+  }
+  return array;
+}
+
 }  // namespace
 
 std::string format_status_response(const calibration::CalibrationStatus& status, hal::TimeUs now_us,
@@ -145,6 +176,7 @@ std::string format_status_response(const calibration::CalibrationStatus& status,
     json["run"] = std::move(run);
   }
   json["refit"] = refit_json(refit);
+  json["nodes"] = nodes_json(status.nodes);
   return line(json);
 }
 

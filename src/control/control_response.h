@@ -23,6 +23,13 @@
 //            `refit <terms>` would add); null before a run
 //            refit: the last refit requested (refit_service.h: state running, committed,
 //            refused or failed); null before the first
+//            nodes: every bus node of the winches, [{"winch":0,"role":"drive","node_id":1,
+//            "nmt":"operational","configured":true,"cia402":"quick stop active","error_code":"",
+//            "last_emcy":"0x8130 (life guard or heartbeat error)","emcy_register":17,
+//            "pdo_age_ms":12.5,"heartbeat_age_ms":40},...]: NMT state of its heartbeat ("silent"
+//            past the heartbeat timeout, "unknown" never heard), CiA 402 power state (drives;
+//            "" before a statusword), 0x603F while in fault, the last EMCY since the bus was
+//            opened, ages null when never heard
 //   show     {"ok":true,"present":true,"seq":4,"created":"2026-11-22T10:15:00Z","robot":"large",
 //             "model":["catenary"],"samples":35,
 //             "winches":[{"anchor":[x,y,z],"anchor_sigma":[..],"offset":3.2,"offset_sigma":0.03},...],

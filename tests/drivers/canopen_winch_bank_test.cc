@@ -271,6 +271,48 @@ TEST_F(CanopenWinchBankTest, DriveLeftInHomingModeIsSwitchedToProfilePosition) {
   EXPECT_NEAR(bank_->status(0).payout_m, start_m + 0.2, kEncoderMPerCount);
 }
 
+TEST_F(CanopenWinchBankTest, DriveThatSwitchesModeLateIsEnabledOnceItShowsTheMode) {
+  // GIVEN drives in homing mode that show a new mode in 0x6061 only 150 ms
+  // after 0x6060 is written (drives switch asynchronously)
+  virtual_robot::DriveDefaults homing;
+  homing.power_on_mode = 6;
+  start(two_winches(), homing);
+  bus_->set_mode_switch_delay(150'000);
+  // WHEN enabled
+  open_and_configure();
+  ASSERT_TRUE(bank_->enable().ok());
+  run_ms(100);
+  // THEN not yet enabled and no fault while the drive is switching ...
+  EXPECT_NE(bank_->status(0).drive, hal::DriveState::kEnabled);
+  EXPECT_FALSE(bank_->status(0).fault) << bank_->fault_text(0);
+  run_ms(200);
+  // ... and enabled once 0x6061 shows profile position
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(bank_->status(i).drive, hal::DriveState::kEnabled) << "winch " << i << ": " << bank_->fault_text(i);
+    EXPECT_FALSE(bank_->status(i).fault) << bank_->fault_text(i);
+  }
+}
+
+TEST_F(CanopenWinchBankTest, DriveThatNeverShowsTheModeIsRefusedAfterTheTimeout) {
+  // GIVEN drives in homing mode that take longer to switch than the bank waits
+  CanWinchBankConfig config = two_winches();
+  config.mode_switch_timeout_us = 200'000;
+  virtual_robot::DriveDefaults homing;
+  homing.power_on_mode = 6;
+  start(config, homing);
+  bus_->set_mode_switch_delay(10'000'000);
+  // WHEN enabled
+  open_and_configure();
+  ASSERT_TRUE(bank_->enable().ok());
+  run_ms(400);
+  // THEN a latched fault names the node, the object and both values; never enabled
+  EXPECT_TRUE(bank_->status(0).fault);
+  EXPECT_NE(bank_->fault_text(0).find("node 1: 0x6061"), std::string::npos) << bank_->fault_text(0);
+  EXPECT_NE(bank_->fault_text(0).find("still 6 200 ms after the mode was written, expected 1"), std::string::npos)
+      << bank_->fault_text(0);
+  EXPECT_NE(bank_->status(0).drive, hal::DriveState::kEnabled);
+}
+
 TEST_F(CanopenWinchBankTest, IdentityMismatchRefusesToEnable) {
   // GIVEN a configuration that expects another vendor than the drives have
   CanWinchBankConfig config = two_winches();
@@ -413,6 +455,46 @@ TEST_F(CanopenWinchBankTest, DrivesQuickStopWhenTheMasterHeartbeatStops) {
   const double travelled_m = (bus_->drive(0).position_counts() - at_death) * kDriveMPerCount;
   EXPECT_LT(travelled_m, 4.0 * 0.5 + 4.0 * 4.0 / (2 * 40.0) + 0.05);
   EXPECT_LT(bus_->drive(0).position_counts() * kDriveMPerCount, 3.5);  // it did not finish the move
+}
+
+TEST_F(CanopenWinchBankTest, NodeStatusShowsTheDriveInQuickStopAfterAHeartbeatLossUntilTheOperatorResets) {
+  // GIVEN enabled drives whose master fell silent for longer than their consumer time
+  start();
+  open_and_enable();
+  run_ms(1000, false);
+  // WHEN the master is back and stops the winches, as the daemon does when a run fails
+  ASSERT_TRUE(bank_->quick_stop().ok());
+  run_ms(300);
+  // THEN each winch lists its drive and encoder: NMT operational, the drive in quick
+  // stop active with its EMCY 0x8130 (heartbeat), fresh PDOs
+  ASSERT_EQ(bank_->node_count(0), 2);
+  const hal::NodeStatus drive = bank_->node_status(0, 0);
+  EXPECT_STREQ(drive.role, "drive");
+  EXPECT_EQ(drive.node_id, 1);
+  EXPECT_STREQ(drive.nmt, "operational");
+  EXPECT_TRUE(drive.configured);
+  EXPECT_STREQ(drive.power_state, "quick stop active");
+  EXPECT_EQ(drive.emcy_code, 0x8130);
+  EXPECT_STREQ(drive.emcy_text, "life guard or heartbeat error");
+  EXPECT_GE(drive.pdo_age_us, 0);
+  EXPECT_LE(drive.pdo_age_us, 20'000);
+  const hal::NodeStatus encoder = bank_->node_status(0, 1);
+  EXPECT_STREQ(encoder.role, "encoder");
+  EXPECT_EQ(encoder.node_id, 11);
+  EXPECT_STREQ(encoder.power_state, "");
+  EXPECT_EQ(encoder.emcy_code, 0);
+  // AND the drive stays there: nothing takes it out but the operator
+  run_ms(500);
+  EXPECT_STREQ(bank_->node_status(0, 0).power_state, "quick stop active");
+  // WHEN the operator resets the faults THEN it leaves quick stop and stays disabled
+  ASSERT_TRUE(bank_->reset_faults().ok());
+  run_ms(150);
+  EXPECT_STREQ(bank_->node_status(0, 0).power_state, "ready to switch on");
+  EXPECT_EQ(bank_->status(0).drive, hal::DriveState::kDisabled);
+  // AND a node that falls silent says so
+  bus_->drive(1).set_silent(true);
+  run_ms(700);
+  EXPECT_STREQ(bank_->node_status(1, 0).nmt, "silent");
 }
 
 TEST_F(CanopenWinchBankTest, FollowingErrorIsAFaultWithItsEmergency) {

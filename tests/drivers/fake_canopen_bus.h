@@ -25,6 +25,9 @@ class FakeCanopenBus {
     std::unique_ptr<virtual_robot::Cia406Device> encoder;  // null: none
     std::int64_t encoder_per_drive = 2;
     std::int64_t encoder_offset = 1000;  // encoder counts at drive position 0
+    std::uint32_t mode_shown = 0;        // 0x6061 while a mode switch is delayed
+    std::uint32_t mode_written = 0;
+    hal::TimeUs mode_written_us = -1;
   };
 
   explicit FakeCanopenBus(int fd, virtual_robot::DriveDefaults drive_defaults = {},
@@ -45,6 +48,10 @@ class FakeCanopenBus {
     const Winch& w = winches_[i];
     return std::llround(w.drive->position_counts()) * w.encoder_per_drive + w.encoder_offset;
   }
+  // Drives switch modes asynchronously: with a delay, 0x6061 shows a mode
+  // written to 0x6060 only `delay_us` after the write (the virtual device
+  // shows it at once).
+  void set_mode_switch_delay(hal::TimeUs delay_us) { mode_switch_delay_us_ = delay_us; }
   // Every frame the devices received, in order (for tests of what the master sent).
   const std::vector<virtual_robot::BusFrame>& received() const { return received_; }
 
@@ -58,8 +65,10 @@ class FakeCanopenBus {
       for (Winch& w : winches_) {
         w.drive->on_frame(bus, now_us);
         if (w.encoder) w.encoder->on_frame(bus, now_us);
+        lag_mode_display(w, now_us);
       }
     }
+    for (Winch& w : winches_) lag_mode_display(w, now_us);
     const double dt_s = last_step_us_ < 0 ? 0.0 : 1e-6 * static_cast<double>(now_us - last_step_us_);
     last_step_us_ = now_us;
     out_.clear();
@@ -75,7 +84,23 @@ class FakeCanopenBus {
   }
 
  private:
+  void lag_mode_display(Winch& w, hal::TimeUs now_us) {
+    if (mode_switch_delay_us_ <= 0) return;
+    auto& od = w.drive->od();
+    const std::uint32_t written = od.get(0x6060, 0);
+    if (w.mode_written_us < 0) {
+      w.mode_shown = w.mode_written = written;
+      w.mode_written_us = now_us;
+    } else if (written != w.mode_written) {
+      w.mode_written = written;
+      w.mode_written_us = now_us;
+    }
+    if (now_us - w.mode_written_us >= mode_switch_delay_us_) w.mode_shown = w.mode_written;
+    od.set(0x6061, 0, w.mode_shown);
+  }
+
   FdCanTransport transport_;
+  hal::TimeUs mode_switch_delay_us_ = 0;
   virtual_robot::DriveDefaults drive_defaults_;
   virtual_robot::EncoderDefaults encoder_defaults_;
   hal::TimeUs last_step_us_ = -1;

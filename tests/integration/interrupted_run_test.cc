@@ -38,6 +38,8 @@ TEST(InterruptedRun, ADaemonKilledMidRunIsReportedAfterRestartUntilTheNextStart)
   first->signal(SIGKILL);
   ASSERT_EQ(first->wait_exit(slowed(10s)), std::optional<int>(128 + SIGKILL));
   EXPECT_TRUE(std::filesystem::exists(rig.state_dir + "/run-in-progress.toml"));
+  // (Restarted after the drives' consumer heartbeat time, 500 ms: they quick-stop on their own.)
+  std::this_thread::sleep_for(slowed(1s));
   auto second = rig.start_daemon("second");
   ASSERT_TRUE(wait_until([&] { return rig.answers(); }, slowed(30s))) << second->log();
 
@@ -57,6 +59,25 @@ TEST(InterruptedRun, ADaemonKilledMidRunIsReportedAfterRestartUntilTheNextStart)
                         rig.dir + "/calibctl.log");
   EXPECT_EQ(calibctl.wait_exit(slowed(30s)), std::optional<int>(0));
   EXPECT_NE(calibctl.log().find("\n  interrupted: run interrupted at 20"), std::string::npos) << calibctl.log();
+  // AND the drives, which quick-stopped on their own when the first daemon's
+  // heartbeat stopped (0x1016, 0x6007), are listed in quick stop active
+  int drives_in_quick_stop = 0;
+  EXPECT_TRUE(wait_until(
+      [&] {
+        drives_in_quick_stop = 0;
+        for (const calibctl::JsonValue& node : rig.ask("status")["nodes"].array()) {
+          drives_in_quick_stop += node["role"].string() == "drive" && node["cia402"].string() == "quick stop active";
+        }
+        return drives_in_quick_stop == 4;
+      },
+      slowed(10s)))
+      << drives_in_quick_stop << " drives in quick stop active; status: " << rig.ask("status")["nodes"].array().size()
+      << " nodes";
+  ChildProcess nodes({built_program("tools/calibctl/calibctl"), "--socket", rig.socket, "status"},
+                     rig.dir + "/calibctl-nodes.log");
+  EXPECT_EQ(nodes.wait_exit(slowed(30s)), std::optional<int>(0));
+  EXPECT_NE(nodes.log().find("\n    winch 0 drive 1: operational, quick stop active"), std::string::npos) << nodes.log();
+  std::printf("calibctl status after the restart:\n%s", nodes.log().c_str());
 
   // AND WHEN a new run starts THEN the report is gone; once it is aborted the marker is removed
   ASSERT_TRUE(rig.ask("start")["ok"].boolean()) << second->log();

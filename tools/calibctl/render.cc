@@ -76,6 +76,23 @@ std::string waypoint_progress(const JsonValue& s) {
   return out + "\n";
 }
 
+// "  winch 0 drive 1: operational, quick stop active, 0x603F ..., last EMCY ..., PDO 12 ms ago"
+void append_nodes(std::string& out, const JsonValue& nodes) {
+  if (nodes.array().empty()) return;
+  out += "  nodes:\n";
+  for (const JsonValue& n : nodes.array()) {
+    out += format("    winch %d %s %d: %s", n["winch"].integer(), n["role"].string().c_str(), n["node_id"].integer(),
+                  n["nmt"].string().c_str());
+    if (!n["configured"].boolean()) out += " (not configured)";
+    if (!n["cia402"].string().empty()) out += ", " + n["cia402"].string();
+    if (!n["error_code"].string().empty()) out += ", 0x603F " + n["error_code"].string();
+    if (!n["last_emcy"].string().empty()) out += ", last EMCY " + n["last_emcy"].string();
+    const JsonValue pdo_age_ms = n["pdo_age_ms"];
+    out += pdo_age_ms.is_null() ? std::string(", no PDO yet") : format(", PDO %.0f ms ago", pdo_age_ms.number());
+    out += "\n";
+  }
+}
+
 }  // namespace
 
 std::string render_refit(const JsonValue& refit) {
@@ -119,6 +136,7 @@ std::string render_status(const JsonValue& s) {
     if (!refit_committed) append_refit_hint(out, run);
   }
   if (const JsonValue refit = s["refit"]; !refit.is_null()) out += "  " + render_refit(refit);
+  append_nodes(out, s["nodes"]);
   return out;
 }
 

@@ -31,6 +31,38 @@ TEST(ControlResponse, NumbersAreTheShortestTextThatReadsBackAndNonFiniteIsNull) 
   EXPECT_NE(format_status_response(status, 42'000'000).find("\"progress\":null,"), std::string::npos);
 }
 
+TEST(ControlResponse, StatusListsEveryNodeWithItsStates) {
+  // GIVEN a drive in quick stop active after a heartbeat loss, and an encoder never heard
+  calibration::CalibrationStatus status;
+  hal::NodeStatus drive;
+  drive.role = "drive";
+  drive.node_id = 1;
+  drive.nmt = "operational";
+  drive.configured = true;
+  drive.power_state = "quick stop active";
+  drive.emcy_code = 0x8130;
+  drive.emcy_register = 0x11;
+  drive.emcy_text = "life guard or heartbeat error";
+  drive.pdo_age_us = 12'500;
+  drive.heartbeat_age_us = 40'000;
+  hal::NodeStatus encoder;
+  encoder.role = "encoder";
+  encoder.node_id = 11;
+  status.nodes = {{0, drive}, {0, encoder}};
+  // WHEN its status is written
+  const std::string response = format_status_response(status, 42'000'000);
+  // THEN each node has its states, 0x603F, last EMCY and ages (null when never heard)
+  EXPECT_NE(response.find("\"nodes\":[{\"winch\":0,\"role\":\"drive\",\"node_id\":1,\"nmt\":\"operational\","
+                          "\"configured\":true,\"cia402\":\"quick stop active\",\"error_code\":\"\","
+                          "\"last_emcy\":\"0x8130 (life guard or heartbeat error)\",\"emcy_register\":17,"
+                          "\"pdo_age_ms\":12.5,\"heartbeat_age_ms\":40},{\"winch\":0,\"role\":\"encoder\","
+                          "\"node_id\":11,\"nmt\":\"unknown\",\"configured\":false,\"cia402\":\"\","
+                          "\"error_code\":\"\",\"last_emcy\":\"\",\"emcy_register\":0,\"pdo_age_ms\":null,"
+                          "\"heartbeat_age_ms\":null}]}\n"),
+            std::string::npos)
+      << response;
+}
+
 TEST(ControlResponse, HistoryKeepsItsFieldOrder) {
   // GIVEN one valid and one unreadable stored version WHEN listed
   std::vector<store::HistoryEntry> history(2);
