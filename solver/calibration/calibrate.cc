@@ -8,6 +8,8 @@
 
 #include "solver/calibration/gross_errors.h"
 #include "solver/calibration/model_fit_check.h"
+#include "solver/calibration/noise_components.h"
+#include "solver/calibration/refusal_cause.h"
 #include "solver/calibration/row_attribution.h"
 #include "solver/calibration/single_fit.h"
 #include "solver/calibration/start_selection.h"
@@ -36,15 +38,6 @@ Robot started_at(const Robot& robot, const CalibrationResult& fit) {
   Robot start = robot;
   for (int i = 0; i < kCableCount; ++i) start.winches[i].anchor_world = fit.calibration.winches[i].anchor_world;
   return start;
-}
-
-// The share of rows with a gross error.
-double gross_error_row_fraction(const CalibrationResult& result, std::size_t rows) {
-  std::vector<int> ids;
-  for (const SensorReading& r : result.gross_errors) ids.push_back(r.row);
-  std::sort(ids.begin(), ids.end());
-  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-  return rows ? static_cast<double>(ids.size()) / static_cast<double>(rows) : 0.0;
 }
 
 CalibrationResult calibrate_with_restart(const Robot& robot, const std::vector<Sample>& samples,
@@ -101,14 +94,24 @@ CalibrationResult calibrate_with_restart(const Robot& robot, const std::vector<S
   return first;
 }
 
-std::string rows_text(const std::vector<SensorReading>& readings) {
+// The readings of a refusal in words, the worst few: the report and the
+// summary's list have them all.
+constexpr std::size_t kNamedReadings = 5;
+std::string rows_text(std::vector<SensorReading> readings) {
+  std::stable_sort(readings.begin(), readings.end(), [](const SensorReading& a, const SensorReading& b) {
+    return std::abs(a.value) > std::abs(b.value);
+  });
   std::string text;
-  for (const SensorReading& r : readings) {
+  for (std::size_t j = 0; j < std::min(readings.size(), kNamedReadings); ++j) {
+    const SensorReading& r = readings[j];
     char line[128];
     std::snprintf(line, sizeof line, "%srow %d %s%s %+.1f sigma", text.empty() ? "" : ", ", r.row,
                   sensor_name(r.sensor),
                   r.sensor == SensorKind::kEncoder ? (" " + std::to_string(r.cable)).c_str() : "", r.value);
     text += line;
+  }
+  if (readings.size() > kNamedReadings) {
+    text += " and " + std::to_string(readings.size() - kNamedReadings) + " more (the gross-error list)";
   }
   return text;
 }
@@ -126,11 +129,10 @@ CalibrationResult refit_without(const Robot& robot, const std::vector<Sample>& s
     const double fraction = gross_error_row_fraction(refused, samples.size());
     if (fraction <= options.max_rejected_fraction) return std::nullopt;
     refused.ok = false;
+    refused.refusal = Refusal::kSensorFault;
     refused.calibration.rejected.clear();
     char text[256];
-    std::snprintf(text, sizeof text,
-                  "%.0f of %zu rows (%.0f %%) have gross errors, more than the %.0f %% allowed: the robot or its "
-                  "sensors need attention (or the model does not fit; see cdpr-calib diagnose). ",
+    std::snprintf(text, sizeof text, "%.0f of %zu rows (%.0f %%) have gross errors, more than the %.0f %% allowed; worst: ",
                   std::round(fraction * static_cast<double>(samples.size())), samples.size(), 100.0 * fraction,
                   100.0 * options.max_rejected_fraction);
     refused.message = text + rows_text(readings);
@@ -484,6 +486,15 @@ CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& sampl
   settle_groups(result.calibration.rejected);
   // Once, on the fit kept: the choice among fits above is by the chi-square test alone.
   test_missing_terms(robot, options, result);
+  result.noise = noise_components(robot, options, result);
+  if (result.refusal == Refusal::kSensorFault) {
+    classify_refusal(robot, samples, options, calibrate_from, result);
+    result.message = (result.refusal == Refusal::kModelMisfit ? "the model does not fit: " + result.refusal_evidence +
+                                                                    " (not a sensor fault); "
+                                                              : "the robot or its sensors need attention: " +
+                                                                    result.refusal_evidence + "; ") +
+                     result.message;
+  }
   return result;
 }
 

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "solver/calibration/noise_scale.h"
 #include "solver/model/calibration.h"
 #include "solver/model/effects.h"
 #include "solver/nls/levenberg_marquardt.h"
@@ -132,6 +133,14 @@ enum class MisfitCause {
 // What the user should do about a flagged fit, one sentence.
 const char* misfit_advice(MisfitCause cause);
 
+// Why calibrate() refused a fit whose rows have too many gross errors
+// (solver/calibration/refusal_cause.h).
+enum class Refusal {
+  kNone,         // not refused: ok, or a fit that failed (message says why)
+  kSensorFault,  // more rows with gross errors than allowed, and no model term or noise scale explains them
+  kModelMisfit,  // as many rows, but a model term or a noise scale brings them within the limit
+};
+
 struct CalibrationResult {
   bool ok = false;
   std::string message;      // why it failed, or the solver's termination message
@@ -142,6 +151,10 @@ struct CalibrationResult {
   // rows were left out of the final fit. Filled when ok and when refused for
   // too many of them.
   std::vector<SensorReading> gross_errors;
+  // When refused for its gross errors: the sensors or the model, with what
+  // was tried (kModelMisfit: the candidate that explains the rows first).
+  Refusal refusal = Refusal::kNone;
+  std::string refusal_evidence;
   // Each reading left out of this fit (Sample::encoder_left_out,
   // force_left_out) as the fit predicts it: its normalised residual, its
   // row's pose and force fitted without it (a leave-one-out residual).
@@ -164,6 +177,10 @@ struct CalibrationResult {
   // The final catenary fit's rows, for the tests that follow it (when ok).
   std::vector<FittedRow> fitted_rows;
   std::vector<FittedEffect> effects;  // in CalibrationOptions::effects order, when ok
+  // The noise the final fit's residuals imply per sensor group against
+  // robot.toml's sigmas (solver/calibration/noise_components.h), when ok
+  // (catenary): reported, not acted on; cdpr-calib diagnose weighs them.
+  std::vector<NoiseComponent> noise;
   // Covariance (tangent) of the global variables, in global_keys order:
   // AnchorKey(i), OffsetKey(i) per cable, then each effect's EffectKey.
   std::vector<Key> global_keys;

@@ -5,6 +5,7 @@
 #include <optional>
 #include <utility>
 
+#include "solver/calibration/noise_components.h"
 #include "solver/diagnosis/fit_comparison.h"
 #include "solver/diagnosis/held_out_comparison.h"
 #include "solver/diagnosis/model_search.h"
@@ -67,12 +68,13 @@ std::string score_text(const CandidateScore& s) {
 // Fits and scores every effect that can still be added (Bonferroni: alpha
 // over their number) and ranks them.
 Round try_candidates(const Robot& robot, const std::vector<Sample>& samples, const DiagnosisOptions& options,
-                     const DiagnosisStep& current) {
+                     const DiagnosisStep& current, std::size_t noise_candidates) {
   Round r;
   for (Effect e : options.candidates) {
     if (can_add(current.model, e)) r.untried.push_back(e);
   }
-  const double level = options.alpha / static_cast<double>(std::max<std::size_t>(1, r.untried.size()));
+  const double level =
+      options.alpha / static_cast<double>(std::max<std::size_t>(1, r.untried.size() + noise_candidates));
   for (Effect e : r.untried) {
     const std::vector<Effect> with = with_effect(current.model, e);
     HeldOutEvaluation f = cross_validate(robot, samples, options, with);
@@ -111,7 +113,7 @@ Round try_candidates(const Robot& robot, const std::vector<Sample>& samples, con
 // The step that adds e, with its fit on all samples and cross-validation.
 DiagnosisStep adding(const std::vector<Effect>& model, Effect e, CalibrationResult&& fit,
                      HeldOutEvaluation&& held_out) {
-  return {with_effect(model, e), e, std::move(fit), std::move(held_out), {}, replaced_by(model, e)};
+  return {with_effect(model, e), e, std::move(fit), std::move(held_out), {}, replaced_by(model, e), false, std::nullopt, 1.0};
 }
 
 // Adds the round's pair as two steps, so that each effect is named with the
@@ -141,13 +143,144 @@ void add_pair(Diagnosis& d, Round& r, PairChoice& pair, const DiagnosisOptions& 
   d.steps.push_back(adding(d.steps.back().model, second, std::move(pair.fit), std::move(pair.held_out)));
 }
 
-// Forward: adds the best significant candidate (or a pair) while one is
-// significant and fewer than options.max_added were added.
-void add_significant_effects(Diagnosis& d, const Robot& robot, const std::vector<Sample>& samples,
-                             const DiagnosisOptions& options) {
+// What the fits of the workflow see: the data with the stated sigmas as the
+// noise steps have scaled them so far.
+struct Data {
+  Robot robot;
+  std::vector<Sample> samples;
+  DiagnosisOptions options;
+};
+
+// The sensor groups a noise step may still scale: those the current fit
+// measured, each once.
+std::vector<NoiseComponent> noise_untried(const Diagnosis& d) {
+  std::vector<NoiseComponent> out;
+  for (const NoiseComponent& c : d.steps.back().fit.noise) {
+    if (std::none_of(d.noise.begin(), d.noise.end(), [&](const NoiseFinding& f) { return f.group == c.group; })) {
+      out.push_back(c);
+    }
+  }
+  return out;
+}
+
+// A noise candidate scored from the current fit's variance components: the
+// likelihood ratio of scaling the group's sigma, at the round's level. Only
+// a group noisier than stated is a finding (a sigma stated too large widens
+// the anchors' sigmas but does not bias them).
+CandidateScore noise_score(const NoiseComponent& c, double level) {
+  CandidateScore s;
+  s.noise = c.group;
+  s.noise_scale = c.scale;
+  s.evaluated = true;
+  s.fit_chi2_drop = c.likelihood_gain;
+  s.fit_p_value = chi_square_upper_tail(c.likelihood_gain, 1);
+  s.added_parameters = 1;
+  s.level = level;
+  s.significant = c.scale > 1.0 && s.fit_p_value < level;
+  return s;
+}
+
+std::string noise_text(NoiseGroup group, double scale) {
+  return std::string(noise_group_description(group)) + " " + fixed(scale, 2) + "x robot.toml";
+}
+
+// The step that scales `c`'s group by its implied factor: the data change
+// for every later fit. False (nothing changed) when the scaled model cannot
+// be fitted or cross-validated.
+bool add_noise_step(Diagnosis& d, Data& data, const CandidateScore& c) {
+  Data scaled = data;
+  scale_noise(*c.noise, c.noise_scale, scaled.robot, scaled.samples, scaled.options.fit);
+  const std::vector<Effect> model = d.steps.back().model;
+  CalibrationResult fit = fit_all(scaled.robot, scaled.samples, scaled.options, model);
+  HeldOutEvaluation f = fit.ok ? cross_validate(scaled.robot, scaled.samples, scaled.options, model) : HeldOutEvaluation{};
+  if (!fit.ok || !f.ok) {
+    report(data.options, "  cannot scale " + noise_text(*c.noise, c.noise_scale) + ": " +
+                             (fit.ok ? f.message : fit.message));
+    return false;
+  }
+  report(data.options, "add " + noise_text(*c.noise, c.noise_scale) + ": held-out normalized rms " +
+                           fixed(d.steps.back().held_out.normalized_rms(), 3) + " -> " + fixed(f.normalized_rms(), 3));
+  DiagnosisStep step{model, Effect::kElasticity, std::move(fit), std::move(f), {}, std::nullopt, false, std::nullopt,
+                     1.0};
+  step.noise = c.noise;
+  step.noise_scale = c.noise_scale;
+  d.steps.push_back(std::move(step));
+  d.noise.push_back({*c.noise, c.noise_scale});
+  data = std::move(scaled);
+  return true;
+}
+
+// The mimic set of the step about to take `taken` (a term of the round, or
+// a noise score): every other evaluated candidate with a physical fit whose
+// Akaike gain is within kMimicAicMargin of the taken one's. Recorded only
+// when it has more than one member.
+void record_mimics(Diagnosis& d, const Round& r, const std::vector<CandidateScore>& noise_scores,
+                   const CandidateScore& taken) {
+  MimicSet set;
+  set.step = d.steps.size();
+  auto member = [&](const CandidateScore& c, const CalibrationResult* fit) {
+    MimicMember m{c.effect, c.noise, c.noise_scale, taken.aic_gain() - c.aic_gain(), {}};
+    if (fit && !c.noise) {
+      for (const std::string& name : effect_value_names(c.effect)) {
+        for (const std::string& key : {name, name + "_sigma"}) {
+          const auto v = fit->calibration.effects.find(key);
+          if (v != fit->calibration.effects.end()) m.values[key] = v->second;
+        }
+      }
+    }
+    return m;
+  };
+  auto close = [&](const CandidateScore& c) {
+    return c.evaluated && c.failure.empty() && taken.aic_gain() - c.aic_gain() <= kMimicAicMargin;
+  };
+  const bool taken_is_noise = taken.noise.has_value();
+  for (std::size_t j = 0; j < r.scores.size(); ++j) {
+    const bool is_taken = !taken_is_noise && r.scores[j].effect == taken.effect;
+    if (is_taken) set.members.insert(set.members.begin(), member(r.scores[j], &r.fits[j]));
+    else if (close(r.scores[j])) set.members.push_back(member(r.scores[j], &r.fits[j]));
+  }
+  for (const CandidateScore& n : noise_scores) {
+    const bool is_taken = taken_is_noise && n.noise == taken.noise;
+    if (is_taken) set.members.insert(set.members.begin(), member(n, nullptr));
+    else if (n.noise_scale > 1.0 && close(n)) set.members.push_back(member(n, nullptr));
+  }
+  std::stable_sort(set.members.begin() + 1, set.members.end(),
+                   [](const MimicMember& a, const MimicMember& b) { return a.aic_gap < b.aic_gap; });
+  if (set.members.size() > 1) d.mimic_sets.push_back(std::move(set));
+}
+
+// Forward: adds the best significant candidate (or a pair, or a noise
+// scale) while one is significant and fewer than options.max_added were
+// added. Terms and noise scales are ranked by the same criterion (Akaike's
+// on all samples); a noise scale is added alone.
+void add_significant_effects(Diagnosis& d, Data& data) {
+  const Robot& robot = data.robot;
+  const std::vector<Sample>& samples = data.samples;
+  const DiagnosisOptions& options = data.options;
   while (static_cast<int>(d.steps.size()) - 1 < options.max_added) {
-    Round r = try_candidates(robot, samples, options, d.steps.back());
+    const std::vector<NoiseComponent> noisy = noise_untried(d);
+    Round r = try_candidates(robot, samples, options, d.steps.back(), noisy.size());
+    const double level =
+        options.alpha / static_cast<double>(std::max<std::size_t>(1, r.untried.size() + noisy.size()));
+    std::optional<CandidateScore> noise;
+    std::vector<CandidateScore> noise_scores;
+    for (const NoiseComponent& c : noisy) {
+      noise_scores.push_back(noise_score(c, level));
+      const CandidateScore& n = noise_scores.back();
+      report(options, "  try " + noise_text(c.group, c.scale) + ": -2 log L drop " + fixed(n.fit_chi2_drop, 1) +
+                          ", p " + scientific(n.fit_p_value) + " (needs p < " + scientific(level) + ")");
+      if (n.significant && (!noise || n.aic_gain() > noise->aic_gain())) noise = n;
+    }
     for (std::size_t j : r.order) d.steps.back().candidates.push_back(r.scores[j]);
+    for (const CandidateScore& n : noise_scores) d.steps.back().candidates.push_back(n);
+    const bool noise_first = noise && (!r.best || noise->aic_gain() > r.scores[*r.best].aic_gain());
+    if (noise_first) {
+      const std::size_t sets = d.mimic_sets.size();
+      record_mimics(d, r, noise_scores, *noise);
+      if (add_noise_step(d, data, *noise)) continue;
+      d.mimic_sets.resize(sets);
+      if (!r.best) return;
+    }
     if (!r.best) return;
 
     if (options.try_pairs && static_cast<int>(d.steps.size()) + 1 <= options.max_added) {
@@ -163,6 +296,7 @@ void add_significant_effects(Diagnosis& d, const Robot& robot, const std::vector
       }
     }
     const Effect e = r.scores[*r.best].effect;
+    record_mimics(d, r, noise_scores, r.scores[*r.best]);
     report(options, "add " + std::string(effect_model_name(e)) + ": held-out normalized rms " +
                         fixed(d.steps.back().held_out.normalized_rms(), 3) + " -> " +
                         fixed(r.evaluations[*r.best].normalized_rms(), 3));
@@ -202,7 +336,8 @@ void remove_unneeded_effects(Diagnosis& d, const Robot& robot, const std::vector
     const Effect dropped = model[*weakest];
     report(options, "remove " + std::string(effect_model_name(dropped)) +
                         ": not significant with the rest of the model (p " + scientific(weakest_p) + ")");
-    DiagnosisStep step{without, dropped, std::move(weakest_fit), std::move(f), {}, std::nullopt};
+    DiagnosisStep step{without, dropped, std::move(weakest_fit), std::move(f), {}, std::nullopt, false, std::nullopt,
+                       1.0};
     step.removed = true;
     d.steps.push_back(std::move(step));
   }
@@ -241,7 +376,7 @@ void narrow_wide_effects(Diagnosis& d, const Robot& robot, const std::vector<Sam
     report(options, "narrow " + std::string(effect_model_name(was)) + " to " + std::string(effect_model_name(narrow)) +
                         ": its extra parameters are not significant (p " + scientific(lr.p_value) + ", needs p < " +
                         scientific(level) + ")");
-    d.steps.push_back({narrowed, narrow, std::move(fit), std::move(f), {}, was});
+    d.steps.push_back({narrowed, narrow, std::move(fit), std::move(f), {}, was, false, std::nullopt, 1.0});
   }
 }
 
@@ -298,11 +433,13 @@ Diagnosis diagnose_rows(const Robot& robot, const std::vector<Sample>& samples, 
   }
   report(options, "fit " + model_text(model) + ": held-out chi2 " + fixed(start.chi2, 1) + ", expected " +
                       fixed(start.expected_chi2, 1) + ", normalized rms " + fixed(start.normalized_rms(), 3));
-  d.steps.push_back({model, Effect::kElasticity, std::move(start_fit), std::move(start), {}, std::nullopt});
+  d.steps.push_back(
+      {model, Effect::kElasticity, std::move(start_fit), std::move(start), {}, std::nullopt, false, std::nullopt, 1.0});
 
-  add_significant_effects(d, robot, samples, options);
-  remove_unneeded_effects(d, robot, samples, options);
-  narrow_wide_effects(d, robot, samples, options);
+  Data data{robot, samples, options};
+  add_significant_effects(d, data);
+  remove_unneeded_effects(d, data.robot, data.samples, data.options);
+  narrow_wide_effects(d, data.robot, data.samples, data.options);
 
   const HeldOutEvaluation& last = d.steps.back().held_out;
   // A significant excess over what a right model gives is structure,

@@ -30,6 +30,13 @@
 // parameters are not significant at a round's level (alpha / m) goes back to
 // its narrower form.
 //
+// Beside the terms, each round weighs one noise scale per sensor group
+// (solver/calibration/noise_components.h: the variance components at the
+// current fit): a group noisier than robot.toml states is a finding too,
+// ranked with the terms by Akaike's criterion; taken, its sigma is scaled
+// for every later fit. Candidates within kMimicAicMargin of the one a step
+// takes form its mimic set: the data cannot tell them apart.
+//
 // Finally it says whether the held-out misfit is still above the noise:
 // structure that no known effect explains. Pure numerics: progress goes
 // through a callback.
@@ -47,6 +54,13 @@ namespace cdpr {
 
 struct CandidateScore {
   Effect effect = Effect::kElasticity;
+  // A noise candidate instead of a term: the sensor group whose stated sigma
+  // the data say is too small, by this factor (variance components at the
+  // current fit, solver/calibration/noise_components.h). Its fit_chi2_drop
+  // is the -2 log-likelihood drop of the scaled sigma, its parameter one; it
+  // has no held-out drop (one scale over hundreds of rows does not overfit).
+  std::optional<NoiseGroup> noise;
+  double noise_scale = 1.0;
   bool evaluated = false;      // fitted and evaluated on the held-out poses and on all samples
   std::string failure;         // why not, when !evaluated
   double held_out_chi2 = 0.0;
@@ -71,6 +85,38 @@ struct DiagnosisStep {
   std::vector<CandidateScore> candidates;  // tried from this step, best first
   std::optional<Effect> replaced;  // the effect `added` took the place of (load_cell <-> load_cell_bias)
   bool removed = false;            // this step removed `added` from the model
+  // A noise step: it scaled this group's stated sigma by noise_scale (for
+  // this and every later step) and left the model as it was; `added` means
+  // nothing then.
+  std::optional<NoiseGroup> noise;
+  double noise_scale = 1.0;
+};
+
+// One candidate of a mimic set: a term (or noise scale) that explains the
+// data about as well as the one the step took.
+struct MimicMember {
+  Effect effect = Effect::kElasticity;
+  std::optional<NoiseGroup> noise;  // a noise scale instead of a term
+  double noise_scale = 1.0;
+  double aic_gap = 0.0;   // Akaike gain of the term taken less this one's (>= 0)
+  EffectValues values;    // its fitted [effects] values with their sigmas (terms)
+};
+
+// Terms that explain the data about equally on these poses: the one a step
+// took (members[0], gap 0) and every other candidate of its round whose
+// Akaike gain is within kMimicAicMargin of it. The data cannot tell them
+// apart; the step had to take one to go on.
+inline constexpr double kMimicAicMargin = 4.0;
+struct MimicSet {
+  std::size_t step = 0;  // the step that took members[0]
+  std::vector<MimicMember> members;
+};
+
+// A sensor group diagnose found noisier than robot.toml states, with the
+// factor its sigma was scaled by.
+struct NoiseFinding {
+  NoiseGroup group = NoiseGroup::kEncoder;
+  double scale = 1.0;
 };
 
 struct Diagnosis {
@@ -85,6 +131,8 @@ struct Diagnosis {
   // step's normalized rms).
   double structure_p_value = 1.0;
   CalibrationResult final_fit;       // the final model on all samples (== steps.back().fit)
+  std::vector<NoiseFinding> noise;   // the noise steps' findings, in step order
+  std::vector<MimicSet> mimic_sets;  // the steps whose choice had mimics, in step order
   // Gross errors found by the robust fit of the starting model: left out of
   // the whole workflow (a handful of gross errors is not an effect), and
   // every fit after it is least squares on the same readings.

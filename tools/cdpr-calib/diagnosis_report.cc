@@ -1,5 +1,6 @@
 #include "diagnosis_report.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -94,14 +95,104 @@ std::string format_text(const char* fmt, T... values) {
   return report::format(fmt, values...);
 }
 
+// A candidate's name: the term's, or "orientation noise x2.31" for a noise scale.
+std::string candidate_name(const CandidateScore& c) {
+  if (!c.noise) return std::string(effect_model_name(c.effect));
+  return std::string(noise_group_description(*c.noise)) + format_text(" x%.2f", c.noise_scale);
+}
+
+// A mimic member's name: the term's, or "orientation noise x2.31".
+std::string member_name(const MimicMember& m) {
+  if (!m.noise) return std::string(effect_model_name(m.effect));
+  return std::string(noise_group_description(*m.noise)) + format_text(" x%.2f", m.noise_scale);
+}
+
+// The mimic sets that still hold a term of the final model (or a noise
+// finding): a set whose member was later removed says nothing of the answer.
+std::vector<const MimicSet*> standing_mimic_sets(const Diagnosis& d) {
+  std::vector<const MimicSet*> out;
+  const std::vector<Effect>& model = d.steps.back().model;
+  for (const MimicSet& set : d.mimic_sets) {
+    const bool standing = std::any_of(set.members.begin(), set.members.end(), [&](const MimicMember& m) {
+      if (m.noise) return std::any_of(d.noise.begin(), d.noise.end(), [&](const NoiseFinding& f) { return f.group == *m.noise; });
+      return std::any_of(model.begin(), model.end(), [&](Effect e) {
+        return e == m.effect || effect_contains(e, m.effect) || effect_contains(m.effect, e);
+      });
+    });
+    if (standing) out.push_back(&set);
+  }
+  return out;
+}
+
+// "load_cell_bias or load_cell: indistinguishable on these poses (Akaike
+// gap 0.8); load_cell_bias: force_bias = 12.1 +- 1.3; load_cell: ...".
+std::string mimic_text(const MimicSet& set) {
+  std::string names, gaps, values;
+  for (std::size_t j = 0; j < set.members.size(); ++j) {
+    const MimicMember& m = set.members[j];
+    names += (j == 0 ? "" : j + 1 == set.members.size() ? " or " : ", ") + member_name(m);
+    if (j > 0) gaps += (gaps.empty() ? "" : ", ") + format_text("%.1f", m.aic_gap);
+    std::string v;
+    for (const auto& [name, numbers] : m.values) {
+      if (name.ends_with("_sigma")) continue;
+      v += (v.empty() ? "" : ", ") + name + " = " + values_text(m.values, name);
+    }
+    values += "; " + member_name(m) + (v.empty() ? "" : ": " + v);
+  }
+  return names + ": indistinguishable on these poses (Akaike gap " + gaps + " from the first, within " +
+         format_text("%.0f", kMimicAicMargin) + ")" + values;
+}
+
+// "load_cell_bias|load_cell;density_error|elasticity", or "none".
+std::string mimic_list(const Diagnosis& d) {
+  std::string out;
+  for (const MimicSet* set : standing_mimic_sets(d)) {
+    std::string members;
+    for (const MimicMember& m : set->members) {
+      members += (members.empty() ? "" : "|") +
+                 (m.noise ? std::string(noise_group_name(*m.noise)) + "-noise" : std::string(effect_model_name(m.effect)));
+    }
+    out += (out.empty() ? "" : ";") + members;
+  }
+  return out.empty() ? "none" : out;
+}
+
+// "orientation-noise-x2.31": a noise step in the conclusion's list.
+std::string noise_text_of(const DiagnosisStep& step) {
+  std::string name(noise_group_name(*step.noise));
+  return name + format_text("-noise-x%.2f", step.noise_scale);
+}
+
+// "orientation:2.31,encoder:1.40", or "none": the noise steps' findings.
+std::string noise_list(const Diagnosis& d) {
+  std::string out;
+  for (const NoiseFinding& f : d.noise) {
+    out += (out.empty() ? "" : ",") + std::string(noise_group_name(f.group)) + format_text(":%.2f", f.scale);
+  }
+  return out.empty() ? "none" : out;
+}
+
+// "orientation noise 2.31x robot.toml and encoder noise 1.40x robot.toml".
+std::string noise_words(const Diagnosis& d) {
+  std::string out;
+  for (std::size_t j = 0; j < d.noise.size(); ++j) {
+    out += (j == 0 ? "" : j + 1 == d.noise.size() ? " and " : ", ") +
+           std::string(noise_group_description(d.noise[j].group)) + format_text(" %.2fx robot.toml", d.noise[j].scale);
+  }
+  return out;
+}
+
 // One machine-readable line for scripts (tools/diagnose-acceptance.sh).
 void append_summary(std::string& out, const Diagnosis& d, const ReportContext& c) {
   // The terms of the final model beyond the starting one (a term replaced on the way is not named).
   const std::vector<Effect> named = added_effects(d);
   std::string added;
   for (Effect e : named) added += (added.empty() ? "" : ",") + std::string(effect_model_name(e));
-  append(out, "summary: added=%s structure=%s structure_p=%.2g normalized_rms_start=%.4f normalized_rms_final=%.4f",
-         added.empty() ? "none" : added.c_str(), d.structure_remains ? "remains" : "none", d.structure_p_value,
+  append(out, "summary: added=%s noise=%s mimic=%s structure=%s structure_p=%.2g normalized_rms_start=%.4f "
+              "normalized_rms_final=%.4f",
+         added.empty() ? "none" : added.c_str(), noise_list(d).c_str(), mimic_list(d).c_str(),
+         d.structure_remains ? "remains" : "none",
+         d.structure_p_value,
          d.steps.front().held_out.normalized_rms(), d.steps.back().held_out.normalized_rms());
   if (c.truth && d.final_fit.ok) {
     // Of the final fit on all samples: anchors, and the largest |fitted - true| / sigma over the added effects.
@@ -133,7 +224,10 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
   for (std::size_t s = 0; s < d.steps.size(); ++s) {
     const DiagnosisStep& step = d.steps[s];
     append(out, "\nstep %zu: %s\n", s, model_text(step.model).c_str());
-    if (s > 0 && step.removed) {
+    if (s > 0 && step.noise) {
+      append(out, "  scaled the sigma of the %s by %.2f: the residuals say it is noisier than robot.toml states\n",
+             std::string(noise_group_description(*step.noise)).c_str(), step.noise_scale);
+    } else if (s > 0 && step.removed) {
       append(out, "  removed %s: not significant with the rest of the model\n",
              std::string(effect_model_name(step.added)).c_str());
     } else if (s > 0) {
@@ -155,9 +249,12 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
     append(out, "  candidates (held-out chi2 drop and the paired t of its per-pose drops; chi2 drop of the fit on all "
                 "samples and its likelihood-ratio p; significant: positive held-out drop and p below the level):\n");
     for (const CandidateScore& cand : step.candidates) {
-      const std::string name(effect_model_name(cand.effect));
+      const std::string name = candidate_name(cand);
       if (!cand.evaluated) {
         append(out, "    %-14s not evaluated: %s\n", name.c_str(), cand.failure.c_str());
+      } else if (cand.noise) {
+        append(out, "    %-24s  -2 log L drop %9.1f  p %8.2g (level %.2g)%s\n", name.c_str(), cand.fit_chi2_drop,
+               cand.fit_p_value, cand.level, cand.significant ? "  significant" : "");
       } else {
         append(out, "    %-14s %10.1f  t %6.2f  all samples %9.1f  p %8.2g (level %.2g)%s\n", name.c_str(),
                cand.held_out_drop, cand.t_statistic, cand.fit_chi2_drop, cand.fit_p_value, cand.level,
@@ -175,6 +272,10 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
   } else {
     append(out, "added");
     for (std::size_t s = 1; s < d.steps.size(); ++s) {
+      if (d.steps[s].noise) {
+        append(out, " %s", noise_text_of(d.steps[s]).c_str());
+        continue;
+      }
       append(out, " %s%s%s", d.steps[s].removed ? "removed:" : "", std::string(effect_model_name(d.steps[s].added)).c_str(),
              d.steps[s].replaced ? (" (in place of " + std::string(effect_model_name(*d.steps[s].replaced)) + ")").c_str()
                                  : "");
@@ -183,6 +284,7 @@ std::string diagnosis_text(const Diagnosis& d, const ReportContext& c) {
            first.held_out.normalized_rms(), last.held_out.normalized_rms(), first.held_out.rms_encoder_m,
            last.held_out.rms_encoder_m, first.held_out.rms_force_n, last.held_out.rms_force_n);
   }
+  for (const MimicSet* set : standing_mimic_sets(d)) append(out, "MIMICS: %s\n", mimic_text(*set).c_str());
   if (d.structure_remains) {
     append(out, "STRUCTURE REMAINS that no known effect explains: held-out normalized rms %.3f, p = %.2g against the "
                 "noise; strongest residual trend: %s\n",
@@ -250,8 +352,12 @@ report::Verdict verdict_of(const Diagnosis& d, const ReportContext& c) {
     v.conclusion = (added.empty() ? "" : effect_list(added) + " explains part of it, but s") +
                    std::string(added.empty() ? "S" : "") + "tructure remains that no known term explains: " +
                    report::strongest_trend_text(residual_trends(last.held_out));
-  } else if (!added.empty()) {
-    v.conclusion = "Explained by " + effect_list(added) + ": with it the model predicts held-out poses down to the noise";
+  } else if (!added.empty() || !d.noise.empty()) {
+    const std::string what = added.empty()                ? noise_words(d)
+                             : d.noise.empty()            ? effect_list(added)
+                                                          : effect_list(added) + " with " + noise_words(d);
+    v.conclusion = "Explained by " + what + ": with it the model predicts held-out poses down to the noise";
+    for (const MimicSet* set : standing_mimic_sets(d)) v.conclusion += ". But " + mimic_text(*set);
   } else {
     v.conclusion = "The " + model_text(first.model) + " model explains the data: no term needed, nothing above the noise";
   }
@@ -260,6 +366,7 @@ report::Verdict verdict_of(const Diagnosis& d, const ReportContext& c) {
   const CalibrationResult& fit = d.final_fit.ok ? d.final_fit : last.fit;
   const std::string values = report::effect_values_text(fit.calibration.effects, value_names(added));
   v.facts.emplace_back("added", added.empty() ? "nothing" : values.empty() ? effect_list(added) : values);
+  if (!d.noise.empty()) v.facts.emplace_back("noisier than stated", noise_words(d));
   // "a -> b" when the workflow changed the model, else the one value.
   const auto change = [&](const char* fmt, double before, double after) {
     return d.steps.size() > 1 ? format_text(fmt, before) + " -> " + format_text(fmt, after) : format_text(fmt, after);
@@ -309,12 +416,13 @@ std::string candidates_table(const Diagnosis& d) {
   std::vector<std::vector<std::string>> rows;
   for (std::size_t s = 0; s < d.steps.size(); ++s) {
     for (const CandidateScore& cand : d.steps[s].candidates) {
-      const std::string name(effect_model_name(cand.effect));
+      const std::string name = candidate_name(cand);
       if (!cand.evaluated) {
         rows.push_back({std::to_string(s), name, "-", "-", "-", "-", "-", cand.failure});
         continue;
       }
-      rows.push_back({std::to_string(s), name, format_text("%.1f", cand.held_out_drop), format_text("%+.1f", cand.t_statistic),
+      rows.push_back({std::to_string(s), name, cand.noise ? "-" : format_text("%.1f", cand.held_out_drop),
+                      cand.noise ? "-" : format_text("%+.1f", cand.t_statistic),
                       format_text("%.1f", cand.fit_chi2_drop), format_text("%.2g", cand.fit_p_value),
                       format_text("%.2g", cand.level), cand.significant ? "significant" : cand.failure});
     }

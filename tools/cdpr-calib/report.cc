@@ -42,6 +42,7 @@ void print_summary(std::FILE* out, const CalibrationResult& result, const Robot&
   }
   print_effects(out, cal.effects);
   print_term_tests(out, result);
+  print_noise_scales(out, result.noise);
   if (!cal.model_warning.empty()) std::fprintf(out, "MODEL WARNING: %s\n", cal.model_warning.c_str());
 }
 
@@ -59,6 +60,21 @@ void print_term_tests(std::FILE* out, const CalibrationResult& result) {
     asked = asked || t.asked_for;
   }
   std::fprintf(out, " %s\n", asked ? "the model lacks a term" : "none asked for");
+}
+
+void print_noise_scales(std::FILE* out, const std::vector<NoiseComponent>& noise) {
+  if (noise.empty()) return;
+  // The level of the score tests' family: noise that the data call larger
+  // than stated by this much is worth a word, not a refusal.
+  constexpr double kNoisierLevel = 1e-6;
+  std::fprintf(out, "noise the residuals imply (x robot.toml's sigma; variance components):");
+  std::string noisier;
+  for (const NoiseComponent& c : noise) {
+    std::fprintf(out, " %s %.2f%s", std::string(noise_group_name(c.group)).c_str(), c.scale,
+                 &c == &noise.back() ? "" : ",");
+    if (c.p_high < kNoisierLevel) noisier += (noisier.empty() ? "" : ", ") + std::string(noise_group_name(c.group));
+  }
+  std::fprintf(out, "%s\n", noisier.empty() ? "" : ("; NOISIER THAN STATED: " + noisier).c_str());
 }
 
 void print_gross_errors(std::FILE* out, const std::vector<SensorReading>& rejected) {

@@ -21,6 +21,9 @@ void print_truth_comparison(std::FILE* out, const Calibration& calibration, cons
 // freedom and p, or that it is not identifiable (solver/calibration/term_tests.h).
 void print_term_tests(std::FILE* out, const CalibrationResult& result);
 void print_gross_errors(std::FILE* out, const std::vector<SensorReading>& rejected);
+// One line: each sensor group's implied noise over robot.toml's sigma, and
+// the groups whose residuals say they are noisier than stated.
+void print_noise_scales(std::FILE* out, const std::vector<NoiseComponent>& noise);
 // Each planted gross error of truth.toml and whether it was rejected.
 void print_outlier_recall(std::FILE* out, const std::vector<SensorReading>& rejected,
                           const std::vector<SensorReading>& planted);

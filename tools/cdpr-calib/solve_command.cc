@@ -33,6 +33,24 @@ bool write_report(const SolveArgs& args, const CalibrationInputs& inputs, const 
   return true;
 }
 
+// A fit refused for its gross errors: the verdict first (the model or the
+// sensors), then why; the full list of readings only without -q.
+int refused(const SolveArgs& args, const CalibrationResult& result, const Robot& robot) {
+  const bool model = result.refusal == Refusal::kModelMisfit;
+  if (model) {
+    std::fprintf(stderr, "cdpr-calib: the model does not fit (try `cdpr-calib diagnose %s%s%s`), not a sensor "
+                 "fault; nothing written\n", args.robot_path.c_str(), args.samples_path.empty() ? "" : " ",
+                 args.samples_path.c_str());
+  } else {
+    std::fprintf(stderr, "cdpr-calib: sensor fault: more rows with gross errors than allowed, and no model term "
+                 "explains them; the robot or its sensors need attention; nothing written\n");
+  }
+  std::fprintf(stderr, "cdpr-calib: calibration refused: %s%s\n", result.message.c_str(),
+               args.quiet ? " (all of them: run without -q)" : "");
+  if (!args.quiet) print_summary(stdout, result, robot);
+  return model ? kExitRefusedModelMisfit : 2;
+}
+
 }  // namespace
 
 void add_solve_command(CLI::App& app, SolveArgs& args) {
@@ -73,8 +91,10 @@ int run_solve(const SolveArgs& args) {
   if (!inputs) return 1;
   const Robot* const robot = &inputs->robot;
   const std::vector<Sample>* const samples = &inputs->samples;
-  std::fprintf(stdout, "robot %s: %d cables, %zu samples, model %s\n", robot->name.c_str(), robot->cable_count(),
-               samples->size(), args.model.c_str());
+  if (!args.quiet) {
+    std::fprintf(stdout, "robot %s: %d cables, %zu samples, model %s\n", robot->name.c_str(), robot->cable_count(),
+                 samples->size(), args.model.c_str());
+  }
 
   CalibrationOptions options;
   const ModelChoice model = *parse_model(args.model);
@@ -88,6 +108,7 @@ int run_solve(const SolveArgs& args) {
   if (!args.quiet) options.progress = [](const IterationSummary& it) { print_iteration(stdout, it); };
 
   CalibrationResult result = calibrate(*robot, *samples, options);
+  if (!result.ok && result.refusal != Refusal::kNone) return refused(args, result, *robot);
   print_summary(stdout, result, *robot);
   if (!result.ok) {
     std::fprintf(stderr, "cdpr-calib: calibration failed: %s\n", result.message.c_str());

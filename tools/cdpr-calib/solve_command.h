@@ -27,9 +27,13 @@ struct SolveArgs {
 
 void add_solve_command(CLI::App& app, SolveArgs& args);
 // Returns the process exit code: 0 done, 1 bad input, 2 the fit failed
-// (or was refused for too many gross errors), 3 the model does not fit (or
-// the problem is under-determined) and --accept-misfit was not given; the
-// calibration.toml is written in that case, with its model_warning.
+// (or was refused for too many gross errors that no model term explains: a
+// sensor fault), 3 the model does not fit (or the problem is
+// under-determined) and --accept-misfit was not given; the calibration.toml
+// is written in that case, with its model_warning; 4 refused for its gross
+// errors, but a model term or a noise scale explains them: the model does
+// not fit (nothing written).
+inline constexpr int kExitRefusedModelMisfit = 4;
 int run_solve(const SolveArgs& args);
 
 }  // namespace cdpr::tools

@@ -113,6 +113,13 @@ int main(int argc, char** argv) {
   app.add_option("--com-offset", args.com_offset, "hidden centre-of-mass offset x,y,z [m, platform frame]");
   app.add_option("--density-error", config.effects.density_error, "hidden cable density error r: true = nominal * (1 + r)")
       ->check(CLI::Range(-0.9, 10.0));
+  app.add_flag_callback("--weightless-cables", [&config] { config.effects.density_error = -1.0; },
+                        "rigid weightless truth: straight massless cables (density error -1), which a catenary "
+                        "model cannot fit; for the misfit verdict of cdpr-calib solve");
+  app.add_option("--orientation-noise-factor", config.orientation_noise_factor,
+                 "true orientation noise = this times the sigma robot.toml states (no physical effect; for the "
+                 "noise terms of cdpr-calib diagnose)")
+      ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--pulley-radius", config.effects.pulley_radius_m, "hidden swivel-pulley radius [m] (docs/DESIGN.md)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--wind", args.wind, "unknown effect: constant force fx,fy,fz [N, world] on the platform at its CoM");

@@ -22,6 +22,7 @@ Eigen::Vector3d random_vector(Rng& rng, double norm) {
 
 Robot nominal_robot(const TrueRobot& truth, const DatasetConfig& config) {
   Robot nominal = truth.robot;
+  nominal.noise = preset_spec(config.preset).robot.robot.noise;  // the truth's may be noisier than stated
   Rng rng = Rng::stream(config.seed, kStreamAnchorPerturbation);
   for (Winch& winch : nominal.winches) winch.anchor_world += random_vector(rng, config.anchor_perturbation_m);
   if (config.noise_scale > 0.0) {
@@ -45,6 +46,7 @@ TrueRobot make_true_robot(const DatasetConfig& config) {
   const PresetSpec spec = preset_spec(config.preset);
   TrueRobot robot = spec.robot;
   robot.effects = config.effects;
+  robot.robot.noise.orientation_rad *= config.orientation_noise_factor;
   Rng rng = Rng::stream(config.seed, kStreamEncoderOffsets);
   for (double& offset : robot.encoder_offset_m) offset = rng.uniform(-spec.offset_range_m, spec.offset_range_m);
   return robot;

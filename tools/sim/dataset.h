@@ -35,6 +35,10 @@ struct DatasetConfig {
   // Multiplies every sensor sigma; 0 = noiseless. robot.toml's [noise] gets
   // the scaled sigmas (the preset's when 0, since sigmas must be > 0).
   double noise_scale = 1.0;
+  // The true orientation noise over the sigma robot.toml states (1: as
+  // stated): a localisation noisier than its data sheet, for the noise
+  // terms of cdpr-calib diagnose (docs/diagnosis.md).
+  double orientation_noise_factor = 1.0;
   // Waypoint box (platform origin, world) instead of the preset's, e.g. the
   // wider spread a calibration plan uses for observability; both or neither.
   std::optional<Eigen::Vector3d> workspace_min, workspace_max;

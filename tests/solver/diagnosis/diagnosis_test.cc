@@ -271,7 +271,57 @@ TEST(Diagnosis, AddsNothingWhenNothingIsHidden) {
   // claims no structure
   const std::vector<SeedRun> runs = run_seeds(large_robot, 3);
   EXPECT_EQ(named_right(runs, {}).size(), runs.size()) << outcomes(runs);
-  for (const SeedRun& r : runs) EXPECT_FALSE(r.diagnosis.structure_remains) << "seed " << r.seed;
+  for (const SeedRun& r : runs) {
+    EXPECT_FALSE(r.diagnosis.structure_remains) << "seed " << r.seed;
+    EXPECT_TRUE(r.diagnosis.noise.empty()) << "seed " << r.seed << ": a noise scale named";
+  }
+}
+
+TEST(DiagnosisSlow, ALoadCellGainTakenForABiasComesWithItsMimicSet) {
+  // GIVEN a 3 % load-cell gain (seed 2: the gain and a bias explain it about equally)
+  sim::DatasetConfig config = large_robot(2);
+  config.effects.force_gain = 0.03;
+  const auto data = sim::simulate_dataset(config);
+  ASSERT_TRUE(data) << data.error();
+  // WHEN the workflow runs
+  const Diagnosis d = diagnose(data->nominal, data->samples, {});
+  ASSERT_TRUE(d.ok) << d.message;
+  // THEN the term it names stands in a mimic set with the gain, each member
+  // with its fitted values and a gap within the margin
+  ASSERT_EQ(model_text(d.steps.back().model), "load_cell_bias");
+  ASSERT_EQ(d.mimic_sets.size(), 1u);
+  const MimicSet& set = d.mimic_sets[0];
+  ASSERT_EQ(set.members.size(), 2u);
+  EXPECT_DOUBLE_EQ(set.members[0].aic_gap, 0.0);
+  EXPECT_LE(set.members[1].aic_gap, kMimicAicMargin);
+  std::vector<Effect> members;
+  for (const MimicMember& m : set.members) {
+    members.push_back(m.effect);
+    EXPECT_TRUE(m.values.count("force_bias")) << effect_model_name(m.effect);
+  }
+  EXPECT_EQ(sorted(members), sorted({Effect::kLoadCell, Effect::kLoadCellBias}));
+}
+
+TEST(DiagnosisSlow, NamesAnOrientationNoisierThanStatedAndNoTerm) {
+  // GIVEN an orientation twice as noisy as robot.toml states, no physical effect
+  const ConfigOf noisy = [](std::uint64_t seed) {
+    sim::DatasetConfig c = large_robot(seed);
+    c.orientation_noise_factor = 2.0;
+    return c;
+  };
+  // WHEN the workflow runs on 3 seeds
+  const std::vector<SeedRun> runs = run_seeds(noisy, 3);
+  // THEN each names the orientation noise, about 2x, and no model term, and the gap closes
+  EXPECT_EQ(named_right(runs, {}).size(), runs.size()) << outcomes(runs);
+  for (const SeedRun& r : runs) {
+    const Diagnosis& d = r.diagnosis;
+    ASSERT_EQ(d.noise.size(), 1u) << "seed " << r.seed;
+    EXPECT_EQ(d.noise[0].group, NoiseGroup::kOrientation) << "seed " << r.seed;
+    EXPECT_GT(d.noise[0].scale, 1.6) << "seed " << r.seed;
+    EXPECT_LT(d.noise[0].scale, 2.5) << "seed " << r.seed;
+    EXPECT_LT(d.steps.back().held_out.normalized_rms(), d.steps.front().held_out.normalized_rms()) << "seed " << r.seed;
+    EXPECT_FALSE(d.structure_remains) << "seed " << r.seed;
+  }
 }
 
 TEST(DiagnosisSlow, SaysStructureRemainsForAWindNoModelTermDescribes) {
