@@ -16,6 +16,11 @@ bool valid_node_id(int id) { return id >= 1 && id <= kMaxNodeId; }
 
 }  // namespace
 
+double WinchMechanics::m_per_motor_rev() const {
+  constexpr double kPi = 3.14159265358979323846;
+  return drum_diameter_m > 0.0 && gear_ratio > 0.0 ? kPi * drum_diameter_m / gear_ratio : 0.0;
+}
+
 CanConnector make_can_connector(const std::string& endpoint) {
   // Both transports are FdCanTransport; only the way to open the fd differs.
   using Open = hal::Result<std::unique_ptr<FdCanTransport>> (*)(const std::string&);
@@ -59,6 +64,9 @@ std::string validate(const CanWinchBankConfig& config) {
     return "heartbeat timeout, resend interval and frames per update must be positive";
   }
   if (!(config.max_move_m > 0.0) || !(config.max_speed_mps > 0.0)) return "max_move and max_speed must be positive";
+  if (!(config.min_payout_m < config.max_payout_m) || !(config.position_limit_margin_m >= 0.0)) {
+    return "payout range: min must be below max, and the position limit margin not negative";
+  }
   if (!valid_node_id(config.master_node_id)) return "master node id out of 1..127";
   for (const CanWinchConfig& w : config.winches) {
     if (w.drive_node_id == config.master_node_id || w.encoder_node_id == config.master_node_id) {
@@ -78,10 +86,25 @@ CanopenWinchBank::CanopenWinchBank(CanWinchBankConfig config, CanConnector conne
     : config_(std::move(config)), connector_(std::move(connector)), mode_steps_(drive_mode_check()) {
   winches_.reserve(config_.winches.size());
   for (const CanWinchConfig& c : config_.winches) {
-    Winch w{Node(c.drive_node_id, config_.sdo_timeout_us), Node(c.encoder_node_id, config_.sdo_timeout_us),
-            Cia402Drive(config_.resend_interval_us), EncoderUnwrap(), -1, 0.0, EnableStep::kNone, false, {}, false, 0,
-            {}, {}, {}, false, {}};
-    w.drive_node.steps = drive_configuration(c.drive_node_id, config_.master_node_id, c.drive_m_per_count, config_.drive);
+    Winch w{Node(c.drive_node_id, config_.sdo_timeout_us),
+            Node(c.encoder_node_id, config_.sdo_timeout_us),
+            Cia402Drive(config_.resend_interval_us),
+            DriveUnits{},
+            EncoderUnwrap(),
+            -1,
+            0.0,
+            EnableStep::kNone,
+            false,
+            {},
+            false,
+            0,
+            {},
+            {},
+            {},
+            false,
+            {},
+            {}};
+    w.drive_node.probe_steps = drive_probe(config_.drive);
     if (c.encoder_node_id != 0) w.encoder_node.steps = encoder_configuration(c.encoder_node_id, config_.encoder);
     w.error_code_steps = {{SdoStep::Kind::kRead, 0x603F, 0, 2, 0, "error code"}};
     w.profile_steps = {{SdoStep::Kind::kWrite, 0x6081, 0, 4, 0, "profile velocity"},
@@ -89,6 +112,61 @@ CanopenWinchBank::CanopenWinchBank(CanWinchBankConfig config, CanConnector conne
                        {SdoStep::Kind::kWrite, 0x6084, 0, 4, 0, "profile deceleration"}};
     winches_.push_back(std::move(w));
   }
+  for (Winch& w : winches_) w.encoder.set_centre(payout_centre_counts(w));
+  std::map<std::string, std::shared_ptr<const Eds>> loaded;
+  for (std::size_t i = 0; i < winches_.size() && setup_error_.empty(); ++i) {
+    Winch& w = winches_[i];
+    const CanWinchConfig& c = config_.winches[i];
+    load_eds(w.drive_node, config_.drive.eds, loaded);
+    if (c.encoder_node_id != 0) load_eds(w.encoder_node, config_.encoder.eds, loaded);
+    if (!setup_error_.empty()) break;
+    std::string why;
+    if (w.drive_node.eds) {
+      why = fit_to_eds(*w.drive_node.eds, w.drive_node.probe_steps);
+      // The units the EDS gives by default: a drive the configuration cannot fit is refused now, not at its first boot.
+      const EdsEntry* units = w.drive_node.eds->find(0x60A9, 0);
+      const EdsEntry* max_speed = w.drive_node.eds->find(0x6080, 0);
+      const auto value = [](const EdsEntry* e) -> std::optional<std::uint32_t> {
+        if (e == nullptr || !e->default_value) return std::nullopt;
+        return static_cast<std::uint32_t>(*e->default_value);
+      };
+      if (why.empty() && (units == nullptr || units->default_value)) why = make_drive_steps(w, value(units), value(max_speed));
+      if (!why.empty()) setup_error_ = "node " + std::to_string(c.drive_node_id) + ": " + why;
+    }
+    if (setup_error_.empty() && w.encoder_node.eds) {
+      why = fit_to_eds(*w.encoder_node.eds, w.encoder_node.steps);
+      if (!why.empty()) setup_error_ = "node " + std::to_string(c.encoder_node_id) + ": " + why;
+    }
+  }
+}
+
+void CanopenWinchBank::load_eds(Node& node, const std::string& path,
+                                std::map<std::string, std::shared_ptr<const Eds>>& loaded) {
+  if (path.empty()) return;
+  if (auto it = loaded.find(path); it != loaded.end()) {
+    node.eds = it->second;
+    return;
+  }
+  std::string error;
+  std::optional<Eds> eds = Eds::load(path, error);
+  if (!eds) {
+    setup_error_ = "node " + std::to_string(node.id) + ": " + error;
+    return;
+  }
+  node.eds = loaded[path] = std::make_shared<const Eds>(std::move(*eds));
+}
+
+std::string CanopenWinchBank::nodes_without_eds() const {
+  std::string drives, encoders;
+  for (const Winch& w : winches_) {
+    if (!w.drive_node.eds) drives += (drives.empty() ? "" : ", ") + std::to_string(w.drive_node.id);
+    if (w.encoder_node.id != 0 && !w.encoder_node.eds) {
+      encoders += (encoders.empty() ? "" : ", ") + std::to_string(w.encoder_node.id);
+    }
+  }
+  std::string text = drives.empty() ? "" : "drives " + drives;
+  if (!encoders.empty()) text += (text.empty() ? "" : "; ") + ("encoders " + encoders);
+  return text;
 }
 
 hal::Status CanopenWinchBank::check_open() const {
@@ -100,6 +178,7 @@ hal::Status CanopenWinchBank::open() {
   if (std::string problem = validate(config_); !problem.empty()) {
     return hal::Status(hal::ErrorCode::kInvalidArgument, "CAN winch bank: " + problem);
   }
+  if (!setup_error_.empty()) return hal::Status(hal::ErrorCode::kInvalidArgument, "CAN winch bank: " + setup_error_);
   auto transport = connector_();
   if (!transport.ok()) return transport.status();
   transport_ = std::move(transport.value());
@@ -298,11 +377,23 @@ hal::Status CanopenWinchBank::service_node(Winch& w, Node& node, hal::TimeUs now
     node.configure_at_us = -1;
     // PDO parameters change only in pre-operational.
     if (hal::Status s = send(make_nmt(NmtCommand::kEnterPreOperational, node.id)); !s.ok()) return s;
-    c.start(&node.steps);
+    node.probed = node.probe_steps.empty();
+    c.start(node.probed ? &node.steps : &node.probe_steps);
   }
   std::optional<CanFrame> frame = c.poll(now_us);
   switch (c.state()) {
     case NodeConfigurator::State::kDone:
+      if (!node.probed) {
+        node.probed = true;
+        if (std::string why = configure_from_probe(w, node); !why.empty()) {
+          if (w.fault.empty()) w.fault = "configuration refused: node " + std::to_string(node.id) + ": " + why;
+          break;
+        }
+        if (frame) (void)send(*frame);
+        c.start(&node.steps);
+        frame = c.poll(now_us);
+        break;
+      }
       node.configured = true;
       if (&node == &w.encoder_node) {
         w.encoder.set_range(c.read_value(0x6002, 0).value_or(0));
@@ -319,6 +410,36 @@ hal::Status CanopenWinchBank::service_node(Winch& w, Node& node, hal::TimeUs now
     default: break;
   }
   return frame ? send(*frame) : hal::Status::Ok();
+}
+
+std::string CanopenWinchBank::configure_from_probe(Winch& w, Node& node) {
+  const NodeConfigurator& probe = node.configurator;
+  return make_drive_steps(w, probe.read_value(0x60A9, 0), probe.read_value(0x6080, 0));
+}
+
+std::string CanopenWinchBank::make_drive_steps(Winch& w, std::optional<std::uint32_t> si_unit_velocity,
+                                               std::optional<std::uint32_t> max_motor_speed) {
+  const std::size_t i = static_cast<std::size_t>(&w - winches_.data());
+  const CanWinchConfig& c = config_.winches[i];
+  std::string why;
+  const std::optional<DriveUnits> units =
+      drive_units(si_unit_velocity, c.drive_m_per_count, config_.mechanics.m_per_motor_rev(), why);
+  if (!units) return why;
+  const std::uint32_t velocity = drive_value(*units, config_.drive.profile_velocity_mps);
+  if (max_motor_speed && velocity > *max_motor_speed) {
+    // The drive would clamp (or refuse) it, and a clamped winch leaves the coordinated line.
+    return "profile_velocity_mps " + std::to_string(config_.drive.profile_velocity_mps) + " m/s is " +
+           std::to_string(velocity) + " " + units->name + ", above its max motor speed 0x6080 = " +
+           std::to_string(*max_motor_speed) + " " + units->name;
+  }
+  std::vector<SdoStep> steps =
+      drive_configuration(c.drive_node_id, config_.master_node_id, c.drive_m_per_count, *units, config_.drive);
+  if (w.drive_node.eds) {
+    if (std::string problem = fit_to_eds(*w.drive_node.eds, steps); !problem.empty()) return problem;
+  }
+  w.units = *units;
+  w.drive_node.steps = std::move(steps);
+  return {};
 }
 
 hal::Status CanopenWinchBank::service_error_code(Winch& w, hal::TimeUs now_us) {
@@ -354,8 +475,11 @@ hal::Status CanopenWinchBank::service_enable(Winch& w, hal::TimeUs now_us) {
   }
   NodeConfigurator& c = w.drive_node.configurator;
   if (!w.mode_check_started) {
+    // The limits are placed from the present drive and encoder positions.
+    if (!w.encoder.valid() || w.drive_node.last_pdo_us < 0) return hal::Status::Ok();
     w.mode_check_started = true;
-    c.start(&mode_steps_);
+    w.enable_steps = enable_steps(w);
+    c.start(&w.enable_steps);
   }
   std::optional<CanFrame> frame = c.poll(now_us);
   switch (c.state()) {
@@ -373,6 +497,40 @@ hal::Status CanopenWinchBank::service_enable(Winch& w, hal::TimeUs now_us) {
     default: break;
   }
   return frame ? send(*frame) : hal::Status::Ok();
+}
+
+std::int64_t CanopenWinchBank::payout_centre_counts(const Winch& w) const {
+  const std::size_t i = static_cast<std::size_t>(&w - winches_.data());
+  const CanWinchConfig& c = config_.winches[i];
+  const double m_per_count = c.encoder_node_id == 0 ? c.drive_m_per_count : c.encoder_m_per_count;
+  const double centre = std::round(0.5 * (config_.min_payout_m + config_.max_payout_m) / m_per_count);
+  // No (finite) payout range: the first reading is taken nearest zero.
+  return std::isfinite(centre) && std::abs(centre) < 1e15 ? static_cast<std::int64_t>(centre) : 0;
+}
+
+std::vector<SdoStep> CanopenWinchBank::enable_steps(const Winch& w) const {
+  std::vector<SdoStep> steps = mode_steps_;
+  const std::size_t i = static_cast<std::size_t>(&w - winches_.data());
+  const double m_per_count = config_.winches[i].drive_m_per_count;
+  const double here = static_cast<double>(w.drive.actual_counts()), payout = payout_m(w);
+  const auto counts = [&](double payout_limit_m, double fallback) {
+    const double c = std::round(here + (payout_limit_m - payout) / m_per_count);
+    if (!std::isfinite(c) || c < std::numeric_limits<std::int32_t>::min() || c > std::numeric_limits<std::int32_t>::max()) {
+      return fallback;  // beyond what the drive counts: its whole range on that side
+    }
+    return c;
+  };
+  constexpr double kMin = std::numeric_limits<std::int32_t>::min(), kMax = std::numeric_limits<std::int32_t>::max();
+  const double margin = config_.position_limit_margin_m;
+  // A negative m_per_count turns the payout range over in drive counts.
+  const bool forward = m_per_count > 0.0;
+  const double lo = counts(forward ? config_.min_payout_m - margin : config_.max_payout_m + margin, kMin);
+  const double hi = counts(forward ? config_.max_payout_m + margin : config_.min_payout_m - margin, kMax);
+  steps.push_back({SdoStep::Kind::kWriteVerify, 0x607D, 1, 4,
+                   static_cast<std::uint32_t>(static_cast<std::int32_t>(lo)), "software position limit min"});
+  steps.push_back({SdoStep::Kind::kWriteVerify, 0x607D, 2, 4,
+                   static_cast<std::uint32_t>(static_cast<std::int32_t>(hi)), "software position limit max"});
+  return steps;
 }
 
 hal::Status CanopenWinchBank::poll_drives(hal::TimeUs now_us) {

@@ -121,11 +121,8 @@ hal::Status CanopenWinchBank::set_target_payouts(const double* payouts_m) {
   for (int i = 0; i < winch_count(); ++i) {
     Winch& w = winches_[static_cast<std::size_t>(i)];
     const double share = longest_m > 0.0 ? std::abs(payouts_m[i] - status(i).payout_m) / longest_m : 1.0;
-    const double m_per_count = std::abs(config_.winches[static_cast<std::size_t>(i)].drive_m_per_count);
-    // At least one count per second (and per s^2): CiA 402 drives refuse 0.
-    const auto scaled = [&](double per_s) {
-      return static_cast<std::uint32_t>(std::max(1.0, std::round(share * per_s / m_per_count)));
-    };
+    // In the drive's own units (drive_units.h), at least 1: CiA 402 drives refuse 0.
+    const auto scaled = [&](double per_s) { return std::max<std::uint32_t>(1, drive_value(w.units, share * per_s)); };
     w.profile_steps[0].value = scaled(d.profile_velocity_mps);
     w.profile_steps[1].value = scaled(d.profile_acceleration_mps2);
     w.profile_steps[2].value = scaled(d.profile_deceleration_mps2);
