@@ -192,6 +192,8 @@ class CanopenWinchBank final : public hal::WinchBank {
   std::string make_drive_steps(Winch& winch, std::optional<std::uint32_t> si_unit_velocity,
                                std::optional<std::uint32_t> max_motor_speed);
   void load_eds(Node& node, const std::string& path, std::map<std::string, std::shared_ptr<const Eds>>& loaded);
+  // Loads the EDS files and fits the steps to them; a misfit goes to setup_error_.
+  void fit_to_devices();
   hal::Status service_enable(Winch& winch, hal::TimeUs now_us);
   // 0x6060/0x6061 and 0x607D from min/max_payout_m and the present positions.
   std::vector<SdoStep> enable_steps(const Winch& winch) const;
