@@ -22,7 +22,8 @@ export CMAKE_GENERATOR ?= Ninja
 # megabytes the demo does not run.
 BUILD_PACKAGES := build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev \
                   libmodbus-dev libsystemd-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev \
-                  libgtest-dev libgmock-dev libgpiod-dev systemd ninja-build libseccomp-dev
+                  libgtest-dev libgmock-dev libgpiod-dev systemd ninja-build libseccomp-dev \
+                  libinih-dev
 TEST_PACKAGES  := mbpoll bubblewrap lintian chromium tidy nodejs python3
 DEB_PACKAGES   := $(BUILD_PACKAGES) $(TEST_PACKAGES)
 # mbpoll: a Modbus master neither the daemon nor the virtual robot shares

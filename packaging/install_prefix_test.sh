@@ -16,7 +16,8 @@ for program in calibctl cdpr-calib cdpr-sim cdpr-accuracy virtual-robot; do
   check_version "/usr/local/bin/$program" "$version"
 done
 for file in lib/sysusers.d/cdpr-calib.conf lib/tmpfiles.d/cdpr-calib.conf \
-            share/doc/cdpr-calibration/examples/cdpr-calibd.toml; do
+            share/doc/cdpr-calibration/examples/cdpr-calibd.toml \
+            share/cdpr-calibration/eds/maxon-epos4.eds share/cdpr-calibration/eds/kuebler-sendix.eds; do
   [[ -f $root/usr/local/$file ]] || fail "/usr/local/$file was not installed"
 done
 echo "install under /usr/local: unit, binaries, docs agree"

@@ -161,6 +161,14 @@ int main(int argc, char** argv) {
   }
   const hal::Clock& clock = sim_clock ? static_cast<const hal::Clock&>(*sim_clock) : monotonic_clock;
   drivers::can::CanopenWinchBank winches(winch_config, drivers::can::make_can_connector(config->winches.endpoint));
+  if (!winches.setup_error().empty()) {
+    log_line("configuration " + config_path + ": winches: " + winches.setup_error());
+    return 1;
+  }
+  if (const std::string plain = winches.nodes_without_eds(); !plain.empty()) {
+    log_line("winches: no EDS for " + plain + " ([winches.drive] / [winches.encoder] eds): configured with the CiA "
+             "402/406 defaults (4 PDOs, transmission type 255, increments per second unless 0x60A9 says otherwise)");
+  }
   drivers::modbus::ModbusLoadCell modbus_load_cell(cell_config, clock);
   // The Modbus transaction (up to response timeout x tries) runs on the
   // reader's thread, never in the 20 ms loop.

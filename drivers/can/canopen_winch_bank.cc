@@ -59,6 +59,9 @@ std::string validate(const CanWinchBankConfig& config) {
     return "heartbeat timeout, resend interval and frames per update must be positive";
   }
   if (!(config.max_move_m > 0.0) || !(config.max_speed_mps > 0.0)) return "max_move and max_speed must be positive";
+  if (!(config.min_payout_m < config.max_payout_m) || !(config.position_limit_margin_m >= 0.0)) {
+    return "payout range: min must be below max, and the position limit margin not negative";
+  }
   if (!valid_node_id(config.master_node_id)) return "master node id out of 1..127";
   for (const CanWinchConfig& w : config.winches) {
     if (w.drive_node_id == config.master_node_id || w.encoder_node_id == config.master_node_id) {
@@ -88,10 +91,28 @@ CanopenWinchBank::CanopenWinchBank(CanWinchBankConfig config, CanConnector conne
   }
   winches_.reserve(config_.winches.size());
   for (const CanWinchConfig& c : config_.winches) {
-    Winch w{Node(c.drive_node_id, config_.sdo_timeout_us), Node(c.encoder_node_id, config_.sdo_timeout_us),
-            Cia402Drive(config_.resend_interval_us), EncoderUnwrap(), -1, 0.0, EnableStep::kNone, false, {}, false, 0,
-            {}, {}, {}, false, {}, 0, 0, 0};
-    w.drive_node.steps = drive_configuration(c.drive_node_id, config_.master_node_id, c.drive_m_per_count, config_.drive);
+    Winch w{Node(c.drive_node_id, config_.sdo_timeout_us),
+            Node(c.encoder_node_id, config_.sdo_timeout_us),
+            Cia402Drive(config_.resend_interval_us),
+            DriveUnits{},
+            EncoderUnwrap(),
+            -1,
+            0.0,
+            EnableStep::kNone,
+            false,
+            {},
+            false,
+            0,
+            {},
+            {},
+            {},
+            false,
+            {},
+            0,
+            0,
+            0,
+            {}};
+    w.drive_node.probe_steps = drive_probe(config_.drive);
     if (c.encoder_node_id != 0) w.encoder_node.steps = encoder_configuration(c.encoder_node_id, config_.encoder);
     w.error_code_steps = {{SdoStep::Kind::kRead, 0x603F, 0, 2, 0, "error code"}};
     w.profile_steps = {{SdoStep::Kind::kWrite, 0x6081, 0, 4, 0, "profile velocity"},
@@ -100,6 +121,8 @@ CanopenWinchBank::CanopenWinchBank(CanWinchBankConfig config, CanConnector conne
                        {SdoStep::Kind::kWrite, 0x6085, 0, 4, 0, "quick stop deceleration"}};
     winches_.push_back(std::move(w));
   }
+  for (Winch& w : winches_) w.encoder.set_centre(payout_centre_counts(w));
+  fit_to_devices();
 }
 
 hal::Status CanopenWinchBank::check_open() const {
@@ -111,6 +134,7 @@ hal::Status CanopenWinchBank::open() {
   if (std::string problem = validate(config_); !problem.empty()) {
     return hal::Status(hal::ErrorCode::kInvalidArgument, "CAN winch bank: " + problem);
   }
+  if (!setup_error_.empty()) return hal::Status(hal::ErrorCode::kInvalidArgument, "CAN winch bank: " + setup_error_);
   auto transport = connector_();
   if (!transport.ok()) return transport.status();
   transport_ = std::move(transport.value());
@@ -313,11 +337,23 @@ hal::Status CanopenWinchBank::service_node(Winch& w, Node& node, hal::TimeUs now
     node.configure_at_us = -1;
     // PDO parameters change only in pre-operational.
     if (hal::Status s = send(make_nmt(NmtCommand::kEnterPreOperational, node.id)); !s.ok()) return s;
-    c.start(&node.steps);
+    node.probed = node.probe_steps.empty();
+    c.start(node.probed ? &node.steps : &node.probe_steps);
   }
   std::optional<CanFrame> frame = c.poll(now_us);
   switch (c.state()) {
     case NodeConfigurator::State::kDone:
+      if (!node.probed) {
+        node.probed = true;
+        if (std::string why = configure_from_probe(w, node); !why.empty()) {
+          if (w.fault.empty()) w.fault = "configuration refused: node " + std::to_string(node.id) + ": " + why;
+          break;
+        }
+        if (frame) (void)send(*frame);
+        c.start(&node.steps);
+        frame = c.poll(now_us);
+        break;
+      }
       node.configured = true;
       if (&node == &w.encoder_node) {
         w.encoder.set_range(c.read_value(0x6002, 0).value_or(0));
@@ -374,8 +410,13 @@ hal::Status CanopenWinchBank::service_enable(Winch& w, hal::TimeUs now_us) {
   if (!w.mode_check_started) {
     if (!writing && now_us < w.mode_read_at_us) return hal::Status::Ok();
     if (c.state() == NodeConfigurator::State::kRunning) return hal::Status::Ok();  // the channel is busy
+    if (writing) {
+      // The limits are placed from the present drive and encoder positions.
+      if (!w.encoder.valid() || w.drive_node.last_pdo_us < 0) return hal::Status::Ok();
+      w.enable_steps = enable_steps(w);
+    }
     w.mode_check_started = true;
-    c.start(writing ? &mode_write_steps_ : &mode_display_steps_);
+    c.start(writing ? &w.enable_steps : &mode_display_steps_);
   }
   std::optional<CanFrame> frame = c.poll(now_us);
   switch (c.state()) {

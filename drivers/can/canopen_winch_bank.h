@@ -8,10 +8,15 @@
 // configure-and-verify over SDO (device_configuration.h: identity, PDO
 // mapping, COB-IDs, transmission types, event timers, drive parameters,
 // heartbeats; the encoder's measuring range 0x6002 read), then NMT start.
+// A drive is first asked its velocity unit (0x60A9) and max motor speed
+// (0x6080): its profile is written in its own units, and a unit the
+// daemon cannot convert to, or a profile velocity above 0x6080, is a
+// latched fault naming the node.
 // A node that does not answer is tried again every resend interval; a
 // refusal or a read-back mismatch is a latched fault naming node, object
 // and values, and the drive is never enabled. Before every enable the
-// drive's mode is written (0x6060 = 1) and 0x6061 read until it shows it.
+// drive's mode is written (0x6060 = 1) and 0x6061 read until it shows it,
+// and its software position limits 0x607D set from the payout range.
 // The master produces its own heartbeat (0x700 + master_node_id) every
 // master_heartbeat_us; the drives' consumer heartbeat (0x1016) makes them
 // stop on their own when the master goes silent.
@@ -22,7 +27,10 @@
 //
 // Units: payout [m] = encoder counts x encoder_m_per_count, the encoder's
 // UNSIGNED32 position unwrapped across its measuring range
-// (encoder_unwrap.h; a jump faster than max_speed_mps is a latched fault).
+// (encoder_unwrap.h; a jump faster than max_speed_mps is a latched fault;
+// the first reading after a (re)start is taken nearest the middle of
+// min/max_payout_m, so a payout range within one measuring range reads
+// the same after every restart).
 // Targets go to the drive relative to the present: target_counts =
 // actual_counts + round((target_m - payout_m) / drive_m_per_count), so
 // motor and cable encoder need not share a zero; |target_m - payout_m| <=
@@ -36,13 +44,17 @@
 // connection reconnects.
 
 #include <functional>
+#include <limits>
+#include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "drivers/can/can_transport.h"
 #include "drivers/can/cia402_drive.h"
 #include "drivers/can/device_configuration.h"
+#include "drivers/can/eds.h"
 #include "drivers/can/encoder_unwrap.h"
 #include "drivers/can/node_configurator.h"
 #include "hal/winch_bank.h"
@@ -54,6 +66,15 @@ struct CanWinchConfig {
   int encoder_node_id = 0;           // 1..127, != drive; 0: no encoder node, use the drive's position
   double encoder_m_per_count = 0.0;  // payout [m] per encoder count, sign gives direction; != 0
   double drive_m_per_count = 0.0;    // payout [m] per drive position count; != 0
+};
+
+// The winch between motor and cable, for drives that count motor
+// revolutions (drive_units.h). All winches alike.
+struct WinchMechanics {
+  double drum_diameter_m = 0.0;  // cable drum, at the cable's centre line; 0: not given
+  double gear_ratio = 1.0;       // motor revolutions per drum revolution
+  // Payout per motor revolution [m]; 0 when the drum is not given.
+  double m_per_motor_rev() const;
 };
 
 struct CanWinchBankConfig {
@@ -71,8 +92,16 @@ struct CanWinchBankConfig {
   // mode_poll_interval_us meanwhile.
   hal::TimeUs mode_switch_timeout_us = 1'000'000;
   hal::TimeUs mode_poll_interval_us = 10'000;
+  // The payout range the winches may travel [m, encoder units] ([waypoints]
+  // min_payout / max_payout) and the margin around it: at every enable the
+  // drive's software position limits 0x607D are set to it, in drive counts
+  // from the present position. Infinite (or beyond INTEGER32): the full range.
+  double min_payout_m = -std::numeric_limits<double>::infinity();
+  double max_payout_m = std::numeric_limits<double>::infinity();
+  double position_limit_margin_m = 0.5;
   DriveDescription drive;
   EncoderDescription encoder;
+  WinchMechanics mechanics;
 };
 
 using CanConnector = std::function<hal::Result<std::unique_ptr<CanTransport>>()>;
@@ -86,7 +115,15 @@ std::string validate(const CanWinchBankConfig& config);
 
 class CanopenWinchBank final : public hal::WinchBank {
  public:
+  // Loads the nodes' EDS files and fits the configuration to them.
   CanopenWinchBank(CanWinchBankConfig config, CanConnector connector);
+
+  // Why the configuration does not fit the devices' EDS files ("node 11:
+  // sendix.eds [6002] AccessType=ro: ..."), or a file that cannot be read;
+  // empty when it fits. open() refuses while it is set.
+  const std::string& setup_error() const { return setup_error_; }
+  // The nodes described by no EDS ("drives 1, 2, 3, 4"): configured with the CiA defaults.
+  std::string nodes_without_eds() const;
 
   int winch_count() const override { return static_cast<int>(config_.winches.size()); }
   hal::Status open() override;
@@ -126,6 +163,9 @@ class CanopenWinchBank final : public hal::WinchBank {
     bool configured = false;
     hal::TimeUs configure_at_us = -1;  // when to (re)start the configuration; -1: not planned
     NodeConfigurator configurator;
+    std::shared_ptr<const Eds> eds;    // null: none, the profile's defaults assumed
+    std::vector<SdoStep> probe_steps;  // asked before `steps` are made (drive: units); empty: none
+    bool probed = false;
     std::vector<SdoStep> steps;
     hal::TimeUs last_start_sent_us = -1;
     std::uint16_t emcy_code = 0;  // its last EMCY, for the operator's status
@@ -138,6 +178,7 @@ class CanopenWinchBank final : public hal::WinchBank {
     Node drive_node;
     Node encoder_node;  // id 0: none
     Cia402Drive drive;
+    DriveUnits units;  // of 0x6081/0x6083/0x6084/0x6085, from the drive's probe
     EncoderUnwrap encoder;
     hal::TimeUs encoder_time_us = -1;
     double target_payout_m = 0.0;
@@ -154,6 +195,7 @@ class CanopenWinchBank final : public hal::WinchBank {
     hal::TimeUs mode_deadline_us = 0;  // kAwaitMode: give up after this
     hal::TimeUs mode_read_at_us = 0;   // kAwaitMode: the next read of 0x6061
     std::uint16_t error_code_value = 0;  // 0x603F of the present fault as read
+    std::vector<SdoStep> enable_steps;  // 0x6060 and 0x607D of this enable
   };
 
   hal::Status send(const CanFrame& frame);
@@ -162,7 +204,19 @@ class CanopenWinchBank final : public hal::WinchBank {
   void on_heartbeat(Winch& winch, Node& node, NmtState state, hal::TimeUs now_us);
   void on_emergency(Winch& winch, Node& node, const CanFrame& frame);
   hal::Status service_node(Winch& winch, Node& node, hal::TimeUs now_us);
+  // The probe's answers made into `node.steps`; empty, else why the node cannot be configured.
+  std::string configure_from_probe(Winch& winch, Node& node);
+  // The drive's steps for the units its 0x60A9 says (nullopt: none), fitted to its EDS; empty, else why not.
+  std::string make_drive_steps(Winch& winch, std::optional<std::uint32_t> si_unit_velocity,
+                               std::optional<std::uint32_t> max_motor_speed);
+  void load_eds(Node& node, const std::string& path, std::map<std::string, std::shared_ptr<const Eds>>& loaded);
+  // Loads the EDS files and fits the steps to them; a misfit goes to setup_error_.
+  void fit_to_devices();
   hal::Status service_enable(Winch& winch, hal::TimeUs now_us);
+  // 0x6060 and 0x607D from min/max_payout_m and the present positions (0x6061 is read after them).
+  std::vector<SdoStep> enable_steps(const Winch& winch) const;
+  // The middle of min/max_payout_m in position counts: where a first reading is unwrapped to.
+  std::int64_t payout_centre_counts(const Winch& winch) const;
   hal::Status service_coordinated_move(hal::TimeUs now_us);
   // Reads 0x603F of a drive that entered fault (what EMCY may have missed).
   hal::Status service_error_code(Winch& winch, hal::TimeUs now_us);
@@ -180,6 +234,7 @@ class CanopenWinchBank final : public hal::WinchBank {
 
   CanWinchBankConfig config_;
   CanConnector connector_;
+  std::string setup_error_;
   std::unique_ptr<CanTransport> transport_;
   std::vector<Winch> winches_;
   std::vector<SdoStep> mode_write_steps_;    // 0x6060 written

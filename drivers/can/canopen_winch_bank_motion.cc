@@ -121,8 +121,8 @@ hal::Status CanopenWinchBank::set_target_payouts(const double* payouts_m) {
   for (int i = 0; i < winch_count(); ++i) {
     Winch& w = winches_[static_cast<std::size_t>(i)];
     const double share = longest_m > 0.0 ? std::abs(payouts_m[i] - status(i).payout_m) / longest_m : 1.0;
-    const MoveProfileCounts p =
-        scaled_move_profile(config_.drive, share, config_.winches[static_cast<std::size_t>(i)].drive_m_per_count);
+    // In the drive's own units (drive_units.h), 0x6085 with the others (move_profile.h).
+    const MoveProfileCounts p = scaled_move_profile(config_.drive, share, w.units);
     w.profile_steps[0].value = p.velocity;
     w.profile_steps[1].value = p.acceleration;
     w.profile_steps[2].value = p.deceleration;

@@ -28,7 +28,7 @@ EncoderUnwrap::Outcome EncoderUnwrap::add(std::uint32_t raw, double max_change_c
   if (broken_) return Outcome::kJump;
   if (raw >= range_) return Outcome::kOutOfRange;
   if (!valid_) {
-    counts_ = nearest(static_cast<std::int64_t>(raw));
+    counts_ = centre_ + nearest(static_cast<std::int64_t>(raw) - centre_);
     last_raw_ = raw;
     valid_ = true;
     return Outcome::kOk;

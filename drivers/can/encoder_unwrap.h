@@ -2,7 +2,10 @@
 // CiA 406 position value (0x6004) to a continuous count. The encoder reports
 // an UNSIGNED32 that wraps at its total measuring range (0x6002): a payout a
 // few counts below the encoder's zero reads as range - a few. The first
-// reading is taken nearest zero (in [-range/2, range/2)); every later one is
+// reading is taken nearest the centre (in [centre - range/2, centre +
+// range/2); the centre is 0 unless the caller knows where the payout range
+// lies, so a raw position past half the range after a restart is not taken
+// a whole range off); every later one is
 // unwrapped as the shortest way round from the previous reading. A change
 // larger than the caller says is physically possible since the previous
 // reading is a jump: the reading is refused and the unwrapper stays invalid
@@ -21,6 +24,8 @@ class EncoderUnwrap {
 
   void set_range(std::uint64_t range_counts);
   std::uint64_t range() const { return range_; }
+  // Where the first reading after a reset is taken nearest [counts]; kept across reset().
+  void set_centre(std::int64_t centre_counts) { centre_ = centre_counts; }
   // Forgets the history (node rebooted, range changed, fault acknowledged).
   void reset();
 
@@ -37,6 +42,7 @@ class EncoderUnwrap {
   std::int64_t nearest(std::int64_t difference) const;
 
   std::uint64_t range_ = 1ull << 32;
+  std::int64_t centre_ = 0;
   bool valid_ = false;
   bool broken_ = false;
   std::uint32_t last_raw_ = 0;

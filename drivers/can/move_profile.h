@@ -1,6 +1,6 @@
 #pragma once
 // The CiA 402 profile of one winch for one coordinated move, in its drive's
-// counts: the drive description's profile velocity, acceleration and
+// units (drive_units.h: counts/s, rpm, ...): the drive description's profile velocity, acceleration and
 // deceleration (0x6081, 0x6083, 0x6084) and its quick-stop deceleration
 // (0x6085), all scaled by share = |delta_i| / max |delta|.
 //
@@ -16,18 +16,21 @@
 #include <cstdint>
 
 #include "drivers/can/device_configuration.h"
+#include "drivers/can/drive_units.h"
 
 namespace cdpr::drivers::can {
 
 struct MoveProfileCounts {
-  std::uint32_t velocity = 1;                 // 0x6081 [counts/s]
-  std::uint32_t acceleration = 1;             // 0x6083 [counts/s^2]
-  std::uint32_t deceleration = 1;             // 0x6084 [counts/s^2]
-  std::uint32_t quick_stop_deceleration = 1;  // 0x6085 [counts/s^2]
+  std::uint32_t velocity = 1;                 // 0x6081 [the drive's velocity unit]
+  std::uint32_t acceleration = 1;             // 0x6083 [that unit per second]
+  std::uint32_t deceleration = 1;             // 0x6084
+  std::uint32_t quick_stop_deceleration = 1;  // 0x6085
 };
 
-// share in [0, 1]; m_per_count != 0 (its sign is ignored). Each value is
-// at least 1: CiA 402 drives refuse 0.
+// share in [0, 1]. Each value is at least 1: CiA 402 drives refuse 0.
+MoveProfileCounts scaled_move_profile(const DriveDescription& drive, double share, const DriveUnits& units);
+// The same for a drive at the standard's default, position counts per
+// second; m_per_count != 0 (its sign is ignored).
 MoveProfileCounts scaled_move_profile(const DriveDescription& drive, double share, double m_per_count);
 
 }  // namespace cdpr::drivers::can

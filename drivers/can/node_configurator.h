@@ -25,6 +25,17 @@ struct SdoStep {
   std::uint8_t size = 4;     // bytes of the object: 1, 2 or 4
   std::uint32_t value = 0;   // written, or expected
   const char* what = "";     // the object's name for messages
+  // The device may not have the object (an unused PDO of a device with
+  // fewer, an optional profile object): abort 0x06020000 or 0x06090011
+  // skips the step (a kRead then has no value) instead of failing the run.
+  bool optional = false;
+  // The bits a read back (kWriteVerify) or kExpect compares: a device may
+  // keep a bit at its own value (COB-ID bit 30, "no RTR").
+  std::uint32_t compare_mask = 0xFFFFFFFFu;
+  // A write refused with any other abort is tried once more with this
+  // value (transmission type 254 where 255 is refused); 0: none.
+  std::uint32_t fallback = 0;
+  bool has_fallback = false;
 };
 
 class NodeConfigurator {
@@ -53,6 +64,7 @@ class NodeConfigurator {
 
  private:
   void fail(State state, const std::string& why);
+  void next_step();
   std::string name(const SdoStep& step) const;
 
   int node_id_;
@@ -60,6 +72,8 @@ class NodeConfigurator {
   const std::vector<SdoStep>* steps_ = nullptr;
   std::size_t next_ = 0;
   bool reading_back_ = false;
+  std::uint32_t written_ = 0;  // what the present step wrote (its value or its fallback)
+  bool fell_back_ = false;
   State state_ = State::kIdle;
   std::string error_;
   std::vector<std::uint32_t> read_values_;  // per step; sized at start()

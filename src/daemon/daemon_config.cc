@@ -358,6 +358,7 @@ std::vector<Section> make_sections() {
   s.push_back(bind(winches_table(), [](auto& c) -> auto& { return c.winches; }));
   s.push_back(bind(drive_table(), [](auto& c) -> auto& { return c.winches.drive; }));
   s.push_back(bind(encoder_table(), [](auto& c) -> auto& { return c.winches.encoder; }));
+  s.push_back(bind(mechanics_table(), [](auto& c) -> auto& { return c.winches.mechanics; }));
   s.push_back(bind_cables(winch_table()));
   s.push_back(bind(load_cell_table(), [](auto& c) -> auto& { return c.load_cell; }));
   s.push_back(bind(pose_table(), [](auto& c) -> auto& { return c.pose; }));
@@ -438,6 +439,14 @@ void refuse_unacknowledged(TomlReader& reader, const toml::table& root, const Da
   }
 }
 
+// Settings one key gives to two modules: the planner's payout range is
+// also the drives' software position limits (0x607D, with [winches]
+// position_limit_margin_m around it).
+void share_keys(DaemonConfig& c) {
+  c.winches.min_payout_m = c.calibrator.planner.min_payout_m;
+  c.winches.max_payout_m = c.calibrator.planner.max_payout_m;
+}
+
 DaemonConfig read_config(TomlReader& reader, const toml::table& root) {
   DaemonConfig c = default_daemon_config();
   for (const Section& section : sections()) {
@@ -455,6 +464,7 @@ DaemonConfig read_config(TomlReader& reader, const toml::table& root) {
   }
   refuse_missing_keys(reader, root);
   refuse_unacknowledged(reader, root, c);
+  share_keys(c);
   return c;
 }
 
@@ -463,6 +473,7 @@ DaemonConfig read_config(TomlReader& reader, const toml::table& root) {
 DaemonConfig default_daemon_config() {
   DaemonConfig c;
   for (const Section& section : sections()) section.set_defaults(c);
+  share_keys(c);
   return c;
 }
 

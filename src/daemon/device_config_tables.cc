@@ -62,12 +62,19 @@ Table<WinchesConfig> winches_table() {
   t.duration("sdo_timeout_ms", &WinchesConfig::sdo_timeout_us, 200, kMs, {10, 10'000},
              "an SDO transfer without an answer this long is aborted")
       .why("the drives' configuration waits this per object; beyond 10 s a dead node stalls the start");
+  t.number("position_limit_margin_m", &WinchesConfig::position_limit_margin_m, 0.5, {0.0, 1000.0}, "m",
+           "the drives' software position limits 0x607D: [waypoints] min_payout .. max_payout widened by this, set "
+           "at every enable")
+      .why("room for a stop's overrun past the payout range; beyond 1 km the drive's limit guards nothing");
   return t;
 }
 
 Table<DriveDescription> drive_table() {
   Table<DriveDescription> t("winches.drive");
   identity_rows(t);
+  t.string("eds", &DriveDescription::eds, "",
+           "the drives' EDS/DCF file (CiA 306; e.g. /usr/share/cdpr-calibration/eds/maxon-epos4.eds): only objects it "
+           "lists are configured, within their access type and range; empty: CiA 402 defaults assumed");
   t.integer("quick_stop_option", &DriveDescription::quick_stop_option, 6, {0, 6}, "",
             "0x605A: 0, 1, 2 (end switched off) or 5, 6 (stay in quick stop)")
       .why("3 and 4 stop at a current or voltage limit, not on a ramp")
@@ -118,12 +125,36 @@ Table<DriveDescription> drive_table() {
 Table<EncoderDescription> encoder_table() {
   Table<EncoderDescription> t("winches.encoder");
   identity_rows(t);
+  t.string("eds", &EncoderDescription::eds, "",
+           "the encoders' EDS/DCF file (e.g. /usr/share/cdpr-calibration/eds/kuebler-sendix.eds); empty: CiA 406 "
+           "defaults assumed");
   t.duration("heartbeat_producer_ms", &EncoderDescription::heartbeat_producer_us, 100, kMs, {10, 1000, true},
              "0x1017 of the encoder")
       .why("UNSIGNED16 whole ms; winches.heartbeat_timeout_ms must be >= 1.5 x this");
   t.duration("pdo_event_timer_ms", &EncoderDescription::pdo_event_timer_us, 20, kMs, {1, 1000, true},
              "TPDO1 (position value 0x6004) period")
       .why("UNSIGNED16 whole ms; the daemon sees a cable's payout no more often");
+  t.integer("code_sequence", &EncoderDescription::code_sequence, -1, {-1, 1}, "",
+            "0x6000 bit 0 the encoders must have: 0 counting up clockwise, 1 counter-clockwise; -1: not checked")
+      .why("CiA 406 code sequence bit; an encoder counting the other way reverses the payout");
+  t.integer("counts_per_revolution", &EncoderDescription::counts_per_revolution, 0, kUnsigned32, "",
+            "0x6001 the encoders must have; 0: not checked")
+      .why("CiA 406 UNSIGNED32");
+  t.integer("measuring_range", &EncoderDescription::measuring_range, 0, kUnsigned32, "",
+            "0x6002 the encoders must have (0x6004 wraps there); 0: not checked, read")
+      .why("CiA 406 UNSIGNED32");
+  return t;
+}
+
+Table<drivers::can::WinchMechanics> mechanics_table() {
+  Table<drivers::can::WinchMechanics> t("winches.mechanics");
+  t.number("drum_diameter_m", &drivers::can::WinchMechanics::drum_diameter_m, 0.0, {0.0, 10.0}, "m",
+           "cable drum at the cable's centre line; 0: not given (drives must then count position increments, "
+           "0x60A9)")
+      .why("the drums of cable robots up to 250 m are well under 10 m");
+  t.number("gear_ratio", &drivers::can::WinchMechanics::gear_ratio, 1.0, {0.0, 10'000.0, true}, "",
+           "motor revolutions per drum revolution; payout per motor revolution = pi x drum_diameter_m / gear_ratio")
+      .why("a winch gearbox reduces by well under 10000:1");
   return t;
 }
 

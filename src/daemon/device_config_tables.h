@@ -12,6 +12,7 @@ namespace cdpr::daemon {
 Table<WinchesConfig> winches_table();
 Table<drivers::can::DriveDescription> drive_table();
 Table<drivers::can::EncoderDescription> encoder_table();
+Table<drivers::can::WinchMechanics> mechanics_table();
 // One table per cable, in robot.toml's [[winch]] order.
 Table<drivers::can::CanWinchConfig> winch_table();
 Table<LoadCellConfig> load_cell_table();

@@ -40,10 +40,11 @@ CanWinchBankConfig two_winches() {
 class CanopenWinchBankTest : public ::testing::Test {
  protected:
   // The bus with two winches whose drives start from `drive` defaults.
-  void start(const CanWinchBankConfig& config = two_winches(), const virtual_robot::DriveDefaults& drive = {}) {
+  void start(const CanWinchBankConfig& config = two_winches(), const virtual_robot::DriveDefaults& drive = {},
+             const virtual_robot::EncoderDefaults& encoder = {}) {
     int fds[2];
     ASSERT_EQ(::socketpair(AF_UNIX, SOCK_STREAM, 0, fds), 0);
-    bus_ = std::make_unique<test::FakeCanopenBus>(fds[1], drive);
+    bus_ = std::make_unique<test::FakeCanopenBus>(fds[1], drive, encoder);
     bus_->add(1, 11);
     bus_->add(2, 12);
     const int bank_fd = fds[0];
@@ -611,6 +612,218 @@ TEST_F(CanopenWinchBankTest, LostPeerIsNotConnected) {
   // THEN update() reports the lost connection
   const hal::Status s = bank_->update(now_us_ + 5'000);
   EXPECT_EQ(s.code(), hal::ErrorCode::kNotConnected) << s.to_string();
+}
+
+// Devices as they come from their makers (docs/fieldbus.md, "Vendor quirks").
+
+TEST_F(CanopenWinchBankTest, EncoderWithTwoTpdosIsConfigured) {
+  // GIVEN encoders with only two TPDOs (0x1802/0x1803 and 0x1A02/0x1A03 do
+  // not exist: abort 0x06020000) and no RPDO, as Kübler Sendix and SIKO come
+  virtual_robot::EncoderDefaults encoder;
+  encoder.quirks.tpdo_count = 2;
+  encoder.quirks.rpdo_count = 0;
+  start(two_winches(), {}, encoder);
+  // WHEN the bank configures them THEN they are alive without a fault, TPDO2 switched off
+  open_and_configure();
+  EXPECT_FALSE(bank_->status(0).fault) << bank_->fault_text(0);
+  EXPECT_FALSE(bus_->encoder(0).od().has_index(0x1802));
+  EXPECT_NE(bus_->encoder(0).od().get(0x1801, 1) & 0x80000000u, 0u);
+  EXPECT_EQ(bus_->encoder(0).od().get(0x1A00, 1), 0x60040020u);
+}
+
+TEST_F(CanopenWinchBankTest, DriveKeepingCobIdBit30IsConfigured) {
+  // GIVEN drives that hold COB-ID bit 30 at 1 (no RTR) whatever is written, as Lika's manual requires
+  virtual_robot::DriveDefaults drive;
+  drive.quirks.cob_id_bit30_fixed = true;
+  start(two_winches(), drive);
+  // WHEN the bank configures them THEN the read back 0x40000201 matches the 0x201 written
+  open_and_configure();
+  EXPECT_EQ(bus_->drive(0).od().get(0x1400, 1), 0x40000201u);
+  EXPECT_EQ(bus_->drive(0).od().get(0x1800, 1), 0x40000181u);
+  // AND the drives enable and move on those PDOs
+  ASSERT_TRUE(bank_->enable().ok());
+  run_ms(100);
+  const double start_m = bank_->status(0).payout_m;
+  ASSERT_TRUE(bank_->set_target_payout(0, start_m + 0.2).ok());
+  run_ms(300);
+  EXPECT_TRUE(bank_->motion_finished());
+  EXPECT_NEAR(bank_->status(0).payout_m, start_m + 0.2, kEncoderMPerCount);
+}
+
+TEST_F(CanopenWinchBankTest, DriveWithoutTransmissionType255GetsType254) {
+  // GIVEN drives that refuse transmission type 255 (abort 0x06090030)
+  virtual_robot::DriveDefaults drive;
+  drive.quirks.no_type_255 = true;
+  start(two_winches(), drive);
+  // WHEN the bank configures them THEN their PDOs are event-driven on type 254 and they are alive
+  open_and_configure();
+  EXPECT_EQ(bus_->drive(0).od().get(0x1800, 2), 254u);
+  EXPECT_EQ(bus_->drive(0).od().get(0x1400, 2), 254u);
+  EXPECT_FALSE(bank_->status(0).fault) << bank_->fault_text(0);
+}
+
+// A drive in rpm: 0.02 m drum, gear 10, 2e-4 m per drive count: 2e-3*pi m
+// per motor revolution, so 1 m/s is 60 / (2e-3*pi) = 9549.3 rpm.
+constexpr double kMPerMotorRev = 3.14159265358979323846 * 0.02 / 10.0;
+
+virtual_robot::DriveDefaults rpm_drive() {
+  virtual_robot::DriveDefaults drive;
+  drive.rpm_units = true;
+  drive.counts_per_rev = kMPerMotorRev / kDriveMPerCount;
+  drive.max_motor_speed_rpm = 60'000;
+  return drive;
+}
+
+CanWinchBankConfig rpm_winches() {
+  CanWinchBankConfig config = two_winches();
+  config.mechanics.drum_diameter_m = 0.02;
+  config.mechanics.gear_ratio = 10.0;
+  return config;
+}
+
+TEST_F(CanopenWinchBankTest, DriveInRpmGetsItsProfileInRpm) {
+  // GIVEN drives whose 0x60A9 says rpm (maxon EPOS4's default), with the winch's mechanics configured
+  start(rpm_winches(), rpm_drive());
+  open_and_configure();
+  // THEN 4 m/s is written as 38197 rpm and 40 m/s^2 as 381972 rpm/s (not 20000 counts/s)
+  EXPECT_EQ(bus_->drive(0).od().get(0x6081, 0), 38197u);
+  EXPECT_EQ(bus_->drive(0).od().get(0x6083, 0), 381972u);
+  EXPECT_EQ(bus_->drive(0).od().get(0x6085, 0), 381972u);
+  // AND a coordinated move (0.8 m and 0.4 m) scales them in rpm: half way together, on target at the end
+  ASSERT_TRUE(bank_->enable().ok());
+  run_ms(100);
+  const double from_m[2] = {bank_->status(0).payout_m, bank_->status(1).payout_m};
+  const double to_m[2] = {from_m[0] + 0.8, from_m[1] + 0.4};
+  ASSERT_TRUE(bank_->set_target_payouts(to_m).ok());
+  run_ms(240);
+  EXPECT_EQ(bus_->drive(1).od().get(0x6081, 0), 19099u);
+  EXPECT_NEAR((bank_->status(0).payout_m - from_m[0]) / 0.8, (bank_->status(1).payout_m - from_m[1]) / 0.4, 0.03);
+  run_ms(400);
+  for (int i = 0; i < 2; ++i) EXPECT_NEAR(bank_->status(i).payout_m, to_m[i], kEncoderMPerCount) << "winch " << i;
+  EXPECT_TRUE(bank_->motion_finished());
+}
+
+TEST_F(CanopenWinchBankTest, DriveInRpmWithoutMechanicsIsRefusedNamingTheNode) {
+  // GIVEN drives in rpm and no [winches.mechanics]
+  start(two_winches(), rpm_drive());
+  ASSERT_TRUE(bank_->open().ok());
+  run_ms(300);
+  // THEN each is a fault naming node and unit, and nothing was written in the wrong unit
+  EXPECT_TRUE(bank_->status(0).fault);
+  EXPECT_NE(bank_->fault_text(0).find("node 1: 0x60A9 (SI unit velocity) = 0x00B44700 (rpm)"), std::string::npos)
+      << bank_->fault_text(0);
+  EXPECT_EQ(bus_->drive(0).od().get(0x1800, 5), 0u);  // the configuration stopped after the probe
+}
+
+TEST_F(CanopenWinchBankTest, ProfileAboveMaxMotorSpeedIsRefused) {
+  // GIVEN drives in rpm whose 0x6080 allows 30000 rpm, and a profile velocity of 4 m/s (38197 rpm)
+  virtual_robot::DriveDefaults drive = rpm_drive();
+  drive.max_motor_speed_rpm = 30'000;
+  start(rpm_winches(), drive);
+  ASSERT_TRUE(bank_->open().ok());
+  run_ms(300);
+  // THEN refused at start, naming node, figure and limit, rather than clamped by the drive
+  EXPECT_TRUE(bank_->status(0).fault);
+  EXPECT_NE(bank_->fault_text(0).find("node 1: profile_velocity_mps 4.000000 m/s is 38197 rpm, above its max motor "
+                                      "speed 0x6080 = 30000 rpm"),
+            std::string::npos)
+      << bank_->fault_text(0);
+}
+
+TEST_F(CanopenWinchBankTest, EncoderDescribedByItsEdsIsNotAskedForPdosItLacks) {
+  // GIVEN 2-TPDO encoders and their EDS in the configuration
+  virtual_robot::EncoderDefaults encoder;
+  encoder.quirks.tpdo_count = 2;
+  encoder.quirks.rpdo_count = 0;
+  CanWinchBankConfig config = two_winches();
+  config.encoder.eds = std::string(CDPR_SOURCE_DIR) + "/systemd/eds/kuebler-sendix.eds";
+  start(config, {}, encoder);
+  EXPECT_EQ(bank_->setup_error(), "");
+  EXPECT_EQ(bank_->nodes_without_eds(), "drives 1, 2");
+  // WHEN configured THEN alive, and no SDO request ever named 0x1802 or 0x1803
+  open_and_configure();
+  for (const virtual_robot::BusFrame& f : bus_->received()) {
+    if (f.id != 0x600 + 11u) continue;
+    const unsigned index = f.data[1] | f.data[2] << 8;
+    EXPECT_TRUE(index != 0x1802 && index != 0x1803) << std::hex << index;
+  }
+}
+
+TEST_F(CanopenWinchBankTest, ConfigurationTheEdsRefusesStopsTheStart) {
+  // GIVEN the virtual drive's EDS and a profile velocity its 0x6081 cannot take (0 counts/s)
+  CanWinchBankConfig config = two_winches();
+  config.drive.eds = std::string(CDPR_SOURCE_DIR) + "/systemd/eds/cdpr-virtual-drive.eds";
+  config.drive.profile_velocity_mps = 1e-5;
+  start(config);
+  // THEN refused before anything is sent, naming node, file, section and key
+  EXPECT_NE(bank_->setup_error().find("node 1: " + config.drive.eds +
+                                      " [6081] LowLimit=1: profile velocity (0x6081:0x00) 0 (0x0) is out of the "
+                                      "device's range"),
+            std::string::npos)
+      << bank_->setup_error();
+  EXPECT_FALSE(bank_->open().ok());
+  // AND an EPOS4 (rpm) without [winches.mechanics] is refused the same way
+  config = two_winches();
+  config.drive.eds = std::string(CDPR_SOURCE_DIR) + "/systemd/eds/maxon-epos4.eds";
+  start(config);
+  EXPECT_NE(bank_->setup_error().find("node 1: 0x60A9 (SI unit velocity) = 0x00B44700 (rpm)"), std::string::npos)
+      << bank_->setup_error();
+}
+
+TEST_F(CanopenWinchBankTest, SoftwarePositionLimitsFollowThePayoutRange) {
+  // GIVEN a payout range of -1..2 m with a 0.5 m margin; winch 0 at 0.1 m, drive at count 0
+  CanWinchBankConfig config = two_winches();
+  config.min_payout_m = -1.0;
+  config.max_payout_m = 2.0;
+  config.position_limit_margin_m = 0.5;
+  config.max_move_m = 10.0;
+  start(config);
+  // WHEN enabled THEN 0x607D is -1.5..2.5 m in drive counts from the present position
+  open_and_enable();
+  ASSERT_NEAR(bank_->status(0).payout_m, 0.1, 1e-12);
+  EXPECT_EQ(bus_->drive(0).od().get_signed(0x607D, 1), -8000);
+  EXPECT_EQ(bus_->drive(0).od().get_signed(0x607D, 2), 12000);
+  // AND a target beyond it stops at the drive's limit, 2.5 m, whatever the master asks
+  ASSERT_TRUE(bank_->set_target_payout(0, 3.5).ok());
+  run_ms(1500);
+  EXPECT_NEAR(bank_->status(0).payout_m, 2.5, kEncoderMPerCount);
+}
+
+TEST_F(CanopenWinchBankTest, ReplacementEncoderCountingTheOtherWayIsRefused) {
+  // GIVEN the configuration's code sequence 0 (counting up clockwise) and encoders set to 1
+  virtual_robot::EncoderDefaults encoder;
+  encoder.operating_parameters = 0x0001;
+  CanWinchBankConfig config = two_winches();
+  config.encoder.code_sequence = 0;
+  config.encoder.counts_per_revolution = 4096;
+  start(config, {}, encoder);
+  ASSERT_TRUE(bank_->open().ok());
+  run_ms(300);
+  // THEN refused naming node, object and values, rather than paying out backwards
+  EXPECT_TRUE(bank_->status(0).fault);
+  EXPECT_NE(bank_->fault_text(0).find("node 11: 0x6000:0x00 (code sequence (bit 0)) is 0x0001, expected 0x0000"),
+            std::string::npos)
+      << bank_->fault_text(0);
+}
+
+TEST_F(CanopenWinchBankTest, PayoutPastHalfTheEncoderRangeReadsTheSameAfterARestart) {
+  // GIVEN winch 0's encoder at 3/4 of its 2^25-count range (2516.6 m at 0.1 mm per count) and a
+  // payout range of 2000..3000 m
+  CanWinchBankConfig config = two_winches();
+  config.min_payout_m = 2000.0;
+  config.max_payout_m = 3000.0;
+  start(config);
+  bus_->winch(0).encoder_offset = 3 * (1 << 23);
+  const double payout_m = 3.0 * (1 << 23) * kEncoderMPerCount;
+  // WHEN the bank starts THEN the payout is 2516.6 m, not a whole range (3355.4 m) less
+  open_and_configure();
+  EXPECT_NEAR(bank_->status(0).payout_m, payout_m, 1e-9);
+  // AND after a restart (close, open: the first reading unwrapped afresh) the same
+  bank_->close();
+  start(config);
+  bus_->winch(0).encoder_offset = 3 * (1 << 23);
+  open_and_configure();
+  EXPECT_NEAR(bank_->status(0).payout_m, payout_m, 1e-9);
 }
 
 TEST(CanopenWinchBankConfig, RejectsSharedNodeIdsAndZeroScales) {

@@ -58,5 +58,22 @@ TEST(EncoderUnwrap, ValueOutsideTheRangeIsRefused) {
   EXPECT_FALSE(e.valid());
 }
 
+TEST(EncoderUnwrap, FirstReadingIsTakenNearTheCentreTheCallerGives) {
+  // GIVEN a 1000-count range and a raw reading past half of it (750)
+  EncoderUnwrap unwrap(1000);
+  // WHEN no centre is given THEN it is taken nearest zero: -250
+  ASSERT_EQ(unwrap.add(750, 10.0), EncoderUnwrap::Outcome::kOk);
+  EXPECT_EQ(unwrap.counts(), -250);
+  // WHEN the payout range says the position lies around 600 (after a restart) THEN 750, then 2750 around 2600
+  unwrap.set_centre(600);
+  unwrap.reset();
+  ASSERT_EQ(unwrap.add(750, 10.0), EncoderUnwrap::Outcome::kOk);
+  EXPECT_EQ(unwrap.counts(), 750);
+  unwrap.set_centre(2600);
+  unwrap.reset();
+  ASSERT_EQ(unwrap.add(750, 10.0), EncoderUnwrap::Outcome::kOk);
+  EXPECT_EQ(unwrap.counts(), 2750);
+}
+
 }  // namespace
 }  // namespace cdpr::drivers::can

@@ -155,9 +155,15 @@ class CanopenPeerTest : public ::testing::Test {
 // GIVEN the peer's 4 drives and 4 encoders and the shipped configuration
 // WHEN the master configures, enables and moves them together
 // THEN every node takes the configuration, and the winches start and arrive together
-void configure_enable_and_move(const std::vector<std::string>& peer_options) {
+void configure_enable_and_move(const std::vector<std::string>& peer_options, int rpm_counts_per_rev = 0) {
   CanopenPeer peer(peer_options);
-  const daemon::WinchesConfig config = example_winches(peer.endpoint());
+  daemon::WinchesConfig config = example_winches(peer.endpoint());
+  if (rpm_counts_per_rev > 0) {
+    // The winches' mechanics as the peer's rpm drives count: one motor
+    // revolution is rpm_counts_per_rev position counts, no gearbox.
+    config.mechanics.gear_ratio = 1.0;
+    config.mechanics.drum_diameter_m = std::abs(config.winches[0].drive_m_per_count) * rpm_counts_per_rev / M_PI;
+  }
   drivers::MonotonicClock clock;
   CanopenWinchBank bank(config, drivers::can::make_can_connector(config.endpoint));
   open_and_enable(bank, clock);
@@ -196,15 +202,16 @@ TEST_F(CanopenPeerTest, ConfiguresEnablesAndMovesFourWinchesTogether) { configur
 // 0x6061 150 ms later: the master waits for it (a single compare refused them).
 TEST_F(CanopenPeerTest, DrivesThatSwitchModeLateAreEnabled) { configure_enable_and_move({"--mode-delay-ms", "150"}); }
 
-// The vendor quirks (issue 33): wait for the master to configure from the
-// devices' EDS (the "canopen-eds" work: PDO count, bit 30, type 254 where
-// 255 is absent, rpm units), enabled at its merge.
-TEST_F(CanopenPeerTest, DISABLED_EncodersWithTwoTpdos) { configure_enable_and_move({"--encoder-tpdos", "2"}); }
-TEST_F(CanopenPeerTest, DISABLED_DrivesKeepRpdoCobIdBit30) { configure_enable_and_move({"--rtr-fixed"}); }
-TEST_F(CanopenPeerTest, DISABLED_DevicesWithoutTransmissionType255) { configure_enable_and_move({"--no-type-255"}); }
-TEST_F(CanopenPeerTest, DISABLED_DrivesInRpmUnits) { configure_enable_and_move({"--rpm", "--counts-per-rev", "4096"}); }
-TEST_F(CanopenPeerTest, DISABLED_AllQuirksTogether) {
-  configure_enable_and_move({"--encoder-tpdos", "2", "--rtr-fixed", "--no-type-255", "--rpm"});
+// The vendor quirks of issue 33 on a stack we did not write: encoders with
+// two TPDOs, drives that keep RPDO COB-ID bit 30, devices without
+// transmission type 255, drives that count their profile in rpm.
+TEST_F(CanopenPeerTest, EncodersWithTwoTpdos) { configure_enable_and_move({"--encoder-tpdos", "2"}); }
+TEST_F(CanopenPeerTest, DrivesKeepRpdoCobIdBit30) { configure_enable_and_move({"--rtr-fixed"}); }
+TEST_F(CanopenPeerTest, DevicesWithoutTransmissionType255) { configure_enable_and_move({"--no-type-255"}); }
+TEST_F(CanopenPeerTest, DrivesInRpmUnits) { configure_enable_and_move({"--rpm", "--counts-per-rev", "4096"}, 4096); }
+TEST_F(CanopenPeerTest, AllQuirksTogether) {
+  configure_enable_and_move({"--encoder-tpdos", "2", "--rtr-fixed", "--no-type-255", "--rpm", "--counts-per-rev", "4096"},
+                            4096);
 }
 
 // The master in a process of its own: configures, enables, starts a long

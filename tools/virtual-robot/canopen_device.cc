@@ -6,6 +6,7 @@ namespace cdpr::virtual_robot {
 namespace {
 
 constexpr std::uint32_t kPdoInvalid = 0x80000000u;
+constexpr std::uint32_t kPdoNoRtr = 0x40000000u;
 constexpr std::uint16_t kEmcyHeartbeat = 0x8130;     // CiA 301: life guard or heartbeat error
 constexpr std::uint16_t kEmcyPdoLength = 0x8210;     // PDO not processed due to length error
 constexpr std::uint8_t kErrorRegisterCommunication = 0x10;
@@ -24,7 +25,8 @@ bool is_pdo_mapping(std::uint16_t index) {
 
 }  // namespace
 
-CanopenDevice::CanopenDevice(int node_id, const DeviceIdentity& identity) : node_id_(node_id) {
+CanopenDevice::CanopenDevice(int node_id, const DeviceIdentity& identity, const CommunicationQuirks& quirks)
+    : node_id_(node_id), quirks_(quirks) {
   od_.add(0x1000, 0, 4, Access::kReadOnly, false, identity.device_type);
   od_.add(0x1001, 0, 1, Access::kReadOnly, true, 0);
   od_.add(0x1016, 0, 1, Access::kReadOnly, false, 1);
@@ -39,23 +41,29 @@ CanopenDevice::CanopenDevice(int node_id, const DeviceIdentity& identity) : node
 
 void CanopenDevice::add_communication_objects(const std::array<PdoDefault, 4>& rpdos,
                                               const std::array<PdoDefault, 4>& tpdos) {
-  for (int n = 0; n < 4; ++n) {
-    const auto rx = static_cast<std::uint16_t>(0x1400 + n), tx = static_cast<std::uint16_t>(0x1800 + n);
+  const std::uint32_t rtr = quirks_.cob_id_bit30_fixed ? kPdoNoRtr : 0;
+  const std::uint32_t type = quirks_.no_type_255 ? 254 : 255;
+  const auto add_mapping = [this](std::uint16_t index, const PdoDefault& pdo) {
+    od_.add(index, 0, 1, Access::kReadWrite, false, static_cast<std::uint32_t>(pdo.mapping.size()));
+    for (std::uint8_t sub = 1; sub <= 8; ++sub) {
+      od_.add(index, sub, 4, Access::kReadWrite, false, sub <= pdo.mapping.size() ? pdo.mapping[sub - 1] : 0);
+    }
+  };
+  for (int n = 0; n < quirks_.rpdo_count; ++n) {
+    const auto rx = static_cast<std::uint16_t>(0x1400 + n);
     od_.add(rx, 0, 1, Access::kReadOnly, false, 2);
-    od_.add(rx, 1, 4, Access::kReadWrite, false, rpdos[n].cob_id);
-    od_.add(rx, 2, 1, Access::kReadWrite, false, 255);
+    od_.add(rx, 1, 4, Access::kReadWrite, false, rtr | rpdos[n].cob_id);
+    od_.add(rx, 2, 1, Access::kReadWrite, false, type);
+    add_mapping(static_cast<std::uint16_t>(0x1600 + n), rpdos[n]);
+  }
+  for (int n = 0; n < quirks_.tpdo_count; ++n) {
+    const auto tx = static_cast<std::uint16_t>(0x1800 + n);
     od_.add(tx, 0, 1, Access::kReadOnly, false, 5);
-    od_.add(tx, 1, 4, Access::kReadWrite, false, tpdos[n].cob_id);
-    od_.add(tx, 2, 1, Access::kReadWrite, false, 255);
+    od_.add(tx, 1, 4, Access::kReadWrite, false, rtr | tpdos[n].cob_id);
+    od_.add(tx, 2, 1, Access::kReadWrite, false, type);
     od_.add(tx, 3, 2, Access::kReadWrite, false, 0);
     od_.add(tx, 5, 2, Access::kReadWrite, false, 0);
-    for (const auto& [base, pdo] : {std::pair{0x1600, &rpdos[n]}, std::pair{0x1A00, &tpdos[n]}}) {
-      const auto index = static_cast<std::uint16_t>(base + n);
-      od_.add(index, 0, 1, Access::kReadWrite, false, static_cast<std::uint32_t>(pdo->mapping.size()));
-      for (std::uint8_t sub = 1; sub <= 8; ++sub) {
-        od_.add(index, sub, 4, Access::kReadWrite, false, sub <= pdo->mapping.size() ? pdo->mapping[sub - 1] : 0);
-      }
-    }
+    add_mapping(static_cast<std::uint16_t>(0x1A00 + n), tpdos[n]);
   }
 }
 
@@ -103,7 +111,7 @@ void CanopenDevice::on_frame(const BusFrame& frame, hal::TimeUs now_us) {
     return;
   }
   if (state_ != NodeState::kOperational) return;  // PDOs only when operational
-  for (int n = 0; n < 4; ++n) {
+  for (int n = 0; n < quirks_.rpdo_count; ++n) {
     const std::uint32_t cob = od_.get(static_cast<std::uint16_t>(0x1400 + n), 1);
     if ((cob & kPdoInvalid) == 0 && (cob & 0x7FF) == frame.id) on_rpdo_frame(n, frame, now_us);
   }
@@ -159,6 +167,7 @@ std::uint32_t CanopenDevice::check_pdo_write(std::uint16_t index, std::uint8_t s
     if ((value & 0x7FF) == 0 || (value & 0x1FFFF800) != 0) return abort_code::kInvalidValue;
   }
   if (is_pdo_communication(index) && subindex == 2 && value > 240 && value < 254) return abort_code::kInvalidValue;
+  if (is_pdo_communication(index) && subindex == 2 && value == 255 && quirks_.no_type_255) return abort_code::kInvalidValue;
   if (is_pdo_mapping(index)) {
     const auto communication = static_cast<std::uint16_t>(index - 0x200);
     if ((od_.get(communication, 1) & kPdoInvalid) == 0) return abort_code::kDeviceState;  // PDO still valid
@@ -186,6 +195,7 @@ std::uint32_t CanopenDevice::write(std::uint16_t index, std::uint8_t subindex, s
   if (e->access == Access::kReadOnly) return abort_code::kReadOnly;
   if (size != 0 && size != e->size) return abort_code::kLength;
   if (e->size < 4) value &= (1u << (8 * e->size)) - 1;
+  if (is_pdo_communication(index) && subindex == 1 && quirks_.cob_id_bit30_fixed) value |= kPdoNoRtr;
   if (is_pdo_communication(index) || is_pdo_mapping(index)) {
     if (const std::uint32_t code = check_pdo_write(index, subindex, value); code != 0) return code;
   }
@@ -291,7 +301,7 @@ bool CanopenDevice::tpdo_data(int pdo, BusFrame& frame) const {
 }
 
 void CanopenDevice::send_tpdos(hal::TimeUs now_us, bool sync) {
-  for (int n = 0; n < 4; ++n) {
+  for (int n = 0; n < quirks_.tpdo_count; ++n) {
     BusFrame frame;
     if (!tpdo_data(n, frame)) continue;
     const auto comm = static_cast<std::uint16_t>(0x1800 + n);

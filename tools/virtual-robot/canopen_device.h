@@ -44,6 +44,18 @@ struct DeviceIdentity {
   std::uint32_t serial = 0;       // 0x1018:04
 };
 
+// Where a device departs from the most common reading of CiA 301, as
+// devices in the field do (docs/fieldbus.md, "Vendor quirks"): fewer PDOs
+// than four (objects 0x14xx/0x16xx/0x18xx/0x1Axx beyond the count do not
+// exist: abort 0x06020000), COB-ID bit 30 kept at 1 whatever is written (no
+// RTR), transmission type 255 refused (0x06090030) with 254 the default.
+struct CommunicationQuirks {
+  int rpdo_count = 4;  // 0..4
+  int tpdo_count = 4;  // 0..4
+  bool cob_id_bit30_fixed = false;
+  bool no_type_255 = false;
+};
+
 // One PDO's power-on default: COB-ID (bit 31 set: not valid) and mapping
 // entries (index << 16 | subindex << 8 | bits).
 struct PdoDefault {
@@ -53,7 +65,7 @@ struct PdoDefault {
 
 class CanopenDevice {
  public:
-  CanopenDevice(int node_id, const DeviceIdentity& identity);
+  CanopenDevice(int node_id, const DeviceIdentity& identity, const CommunicationQuirks& quirks = {});
   virtual ~CanopenDevice() = default;
   CanopenDevice(const CanopenDevice&) = delete;
   CanopenDevice& operator=(const CanopenDevice&) = delete;
@@ -81,7 +93,8 @@ class CanopenDevice {
 
  protected:
   // Call once from the profile's constructor after its objects are added:
-  // the predefined PDO sets (4 RPDOs, 4 TPDOs) and the communication objects.
+  // the predefined PDO sets (the first rpdo_count RPDOs and tpdo_count
+  // TPDOs of these, as the quirks say) and the communication objects.
   void add_communication_objects(const std::array<PdoDefault, 4>& rpdos, const std::array<PdoDefault, 4>& tpdos);
   // Sends EMCY `code` (0 = error reset) and sets the error register.
   void emergency(std::uint16_t code, std::uint8_t error_register);
@@ -125,6 +138,7 @@ class CanopenDevice {
   void queue(std::uint32_t id, std::initializer_list<std::uint8_t> bytes);
 
   int node_id_;
+  CommunicationQuirks quirks_;
   ObjectDictionary od_;
   NodeState state_ = NodeState::kPreOperational;
   bool boot_up_pending_ = true;

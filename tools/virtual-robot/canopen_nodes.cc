@@ -1,5 +1,6 @@
 #include "virtual-robot/canopen_nodes.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace cdpr::virtual_robot {
@@ -10,6 +11,29 @@ drivers::can::CanFrame from_bus(const BusFrame& frame) { return drivers::can::Ca
 
 }  // namespace
 
+std::optional<CanopenQuirks> parse_canopen_quirks(const std::string& names) {
+  CanopenQuirks quirks;
+  std::size_t at = 0;
+  while (at <= names.size()) {
+    const std::size_t comma = std::min(names.find(',', at), names.size());
+    const std::string name = names.substr(at, comma - at);
+    at = comma + 1;
+    if (name.empty() || name == "none") continue;
+    if (name == "two-tpdo-encoder") {
+      quirks.two_tpdo_encoder = true;
+    } else if (name == "rtr-bit30") {
+      quirks.rtr_bit30 = true;
+    } else if (name == "no-type-255") {
+      quirks.no_type_255 = true;
+    } else if (name == "rpm-units") {
+      quirks.rpm_units = true;
+    } else {
+      return std::nullopt;
+    }
+  }
+  return quirks;
+}
+
 CanopenNodes::CanopenNodes(const NodeLayout& layout, RobotPhysics& physics, sim::Rng rng, hal::TimeUs now_us)
     : layout_(layout), physics_(physics), rng_(rng) {
   (void)now_us;
@@ -17,6 +41,20 @@ CanopenNodes::CanopenNodes(const NodeLayout& layout, RobotPhysics& physics, sim:
   drive.power_on_mode = layout.drive_power_on_mode;
   EncoderDefaults encoder;
   encoder.measuring_range = layout.encoder_range_counts;
+  const CanopenQuirks& q = layout.quirks;
+  for (CommunicationQuirks* c : {&drive.quirks, &encoder.quirks}) {
+    c->cob_id_bit30_fixed = q.rtr_bit30;
+    c->no_type_255 = q.no_type_255;
+  }
+  if (q.two_tpdo_encoder) {
+    encoder.quirks.tpdo_count = 2;
+    encoder.quirks.rpdo_count = 0;
+  }
+  if (q.rpm_units) {
+    constexpr double kPi = 3.14159265358979323846;
+    drive.rpm_units = true;
+    drive.counts_per_rev = kPi * layout.drum_diameter_m / layout.gear_ratio / layout.drive_m_per_count;
+  }
   for (int i = 0; i < kCableCount; ++i) {
     drives_[i] = std::make_unique<Cia402Device>(layout.drive_node_id[i], drive);
     drives_[i]->set_initial_position(physics.payout_m(i) / layout.drive_m_per_count);

@@ -17,6 +17,8 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "drivers/can/can_frame.h"
@@ -28,6 +30,19 @@
 
 namespace cdpr::virtual_robot {
 
+// Vendor quirks the nodes play (docs/fieldbus.md, "Vendor quirks"), as
+// --canopen-quirks names them.
+struct CanopenQuirks {
+  bool two_tpdo_encoder = false;  // encoders: TPDO1-2 only, no RPDO (Kübler Sendix, SIKO)
+  bool rtr_bit30 = false;         // every node keeps COB-ID bit 30 at 1 (Lika)
+  bool no_type_255 = false;       // every node refuses transmission type 255 (Lika)
+  bool rpm_units = false;         // drives count 0x6081.. in rpm and rpm/s (maxon EPOS4, Nanotec)
+};
+
+// "two-tpdo-encoder,rtr-bit30,no-type-255,rpm-units" (any of them, "" or
+// "none": none) -> quirks; nullopt for an unknown name.
+std::optional<CanopenQuirks> parse_canopen_quirks(const std::string& names);
+
 struct NodeLayout {
   std::array<int, kCableCount> drive_node_id{1, 2, 3, 4};
   std::array<int, kCableCount> encoder_node_id{11, 12, 13, 14};
@@ -36,6 +51,11 @@ struct NodeLayout {
   std::uint32_t encoder_range_counts = 1u << 26;  // 0x6002: 671 m at 1e-5 m per count
   std::int8_t drive_power_on_mode = 0;            // 0x6060 at power on: 0 none, 1 profile position, 6 homing
   double encoder_noise_m = 0.0;  // 1-sigma per reading [m]
+  CanopenQuirks quirks;
+  // rpm_units: the winch's mechanics the daemon must be told in
+  // [winches.mechanics] (motor counts per revolution follow from drive_m_per_count).
+  double drum_diameter_m = 0.2;
+  double gear_ratio = 10.0;
 };
 
 class CanopenNodes {

@@ -24,8 +24,12 @@ std::uint32_t mapping(std::uint16_t index, std::uint8_t subindex, std::uint8_t b
 }  // namespace
 
 Cia402Device::Cia402Device(int node_id, const DriveDefaults& defaults)
-    : CanopenDevice(node_id, defaults.identity), defaults_(defaults) {
+    : CanopenDevice(node_id, defaults.identity, defaults.quirks), defaults_(defaults) {
   ObjectDictionary& d = od();
+  if (defaults.rpm_units) {
+    d.add(0x6080, 0, 4, Access::kReadWrite, false, defaults.max_motor_speed_rpm);
+    d.add(0x60A9, 0, 4, Access::kReadOnly, false, 0x00B44700);  // rpm
+  }
   d.add(0x603F, 0, 2, Access::kReadOnly, true, 0);
   d.add(0x6007, 0, 2, Access::kReadWrite, false, 1);
   d.add(0x6040, 0, 2, Access::kReadWrite, true, 0);
@@ -39,10 +43,15 @@ Cia402Device::Cia402Device(int node_id, const DriveDefaults& defaults)
   d.add(0x607D, 0, 1, Access::kReadOnly, false, 2);
   d.add(0x607D, 1, 4, Access::kReadWrite, false, static_cast<std::uint32_t>(std::numeric_limits<std::int32_t>::min()));
   d.add(0x607D, 2, 4, Access::kReadWrite, false, static_cast<std::uint32_t>(std::numeric_limits<std::int32_t>::max()));
-  d.add(0x6081, 0, 4, Access::kReadWrite, true, defaults.profile_velocity);
-  d.add(0x6083, 0, 4, Access::kReadWrite, true, defaults.acceleration);
-  d.add(0x6084, 0, 4, Access::kReadWrite, true, defaults.acceleration);
-  d.add(0x6085, 0, 4, Access::kReadWrite, false, defaults.quick_stop_deceleration);
+  // The power-on profile in the drive's own units.
+  const double per_count = defaults.rpm_units ? 60.0 / defaults.counts_per_rev : 1.0;
+  const auto own = [per_count](std::uint32_t counts) {
+    return std::max<std::uint32_t>(1, static_cast<std::uint32_t>(std::lround(counts * per_count)));
+  };
+  d.add(0x6081, 0, 4, Access::kReadWrite, true, own(defaults.profile_velocity));
+  d.add(0x6083, 0, 4, Access::kReadWrite, true, own(defaults.acceleration));
+  d.add(0x6084, 0, 4, Access::kReadWrite, true, own(defaults.acceleration));
+  d.add(0x6085, 0, 4, Access::kReadWrite, false, own(defaults.quick_stop_deceleration));
   const auto id = static_cast<std::uint32_t>(node_id);
   const std::uint32_t off = 0x80000000u;
   add_communication_objects(
@@ -88,7 +97,10 @@ std::uint32_t Cia402Device::check_write(std::uint16_t index, std::uint8_t subind
     case 0x6081:
     case 0x6083:
     case 0x6084:
-    case 0x6085: return value != 0 ? 0 : abort_code::kInvalidValue;
+    case 0x6085:
+      if (value == 0) return abort_code::kInvalidValue;
+      // A velocity above the motor's maximum is refused, not clamped (the master must convert).
+      return index == 0x6081 && defaults_.rpm_units && value > od().get(0x6080, 0) ? abort_code::kInvalidValue : 0;
     default: return 0;
   }
 }
@@ -237,6 +249,11 @@ void Cia402Device::take_setpoint(hal::TimeUs now_us) {
   ack_set_us_ = now_us + static_cast<hal::TimeUs>(1e6 * defaults_.ack_delay_s);
 }
 
+double Cia402Device::counts_per_s(std::uint16_t index) const {
+  const double value = od().get(index, 0);
+  return defaults_.rpm_units ? value * defaults_.counts_per_rev / 60.0 : value;
+}
+
 bool Cia402Device::brake(double deceleration, double dt_s) {
   const double dv = deceleration * dt_s;
   velocity_ = std::abs(velocity_) <= dv ? 0.0 : velocity_ - std::copysign(dv, velocity_);
@@ -245,7 +262,7 @@ bool Cia402Device::brake(double deceleration, double dt_s) {
 }
 
 void Cia402Device::move_towards_target(double dt_s) {
-  const double v_max = od().get(0x6081, 0), accel = od().get(0x6083, 0), decel = od().get(0x6084, 0);
+  const double v_max = counts_per_s(0x6081), accel = counts_per_s(0x6083), decel = counts_per_s(0x6084);
   const double to_go = target_ - demand_;
   if (std::abs(to_go) < 0.5 && std::abs(velocity_) <= decel * dt_s) {
     demand_ = target_;
@@ -275,7 +292,7 @@ void Cia402Device::advance(double dt_s) {
     switch (power_) {
       case Power::kOperationEnabled:
         if ((last_controlword_ & kBitHalt) != 0) {
-          brake(od().get(0x6084, 0), h);
+          brake(counts_per_s(0x6084), h);
         } else if (moving_) {
           move_towards_target(h);
           if (demand_ == target_ && velocity_ == 0.0) {
@@ -287,12 +304,12 @@ void Cia402Device::advance(double dt_s) {
         break;
       case Power::kQuickStopActive: {
         const std::int32_t option = od().get_signed(0x605A, 0);
-        const double decel = option == 1 || option == 5 ? od().get(0x6084, 0) : od().get(0x6085, 0);
+        const double decel = option == 1 || option == 5 ? counts_per_s(0x6084) : counts_per_s(0x6085);
         if (brake(decel, h) && (option == 1 || option == 2)) power_ = Power::kSwitchOnDisabled;
         break;
       }
       case Power::kFaultReaction:
-        if (brake(od().get(0x6085, 0), h)) power_ = Power::kFault;
+        if (brake(counts_per_s(0x6085), h)) power_ = Power::kFault;
         break;
       default: break;
     }

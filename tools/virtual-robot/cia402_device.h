@@ -23,7 +23,13 @@
 //   motor_max_speed) by more than 0x6065, a fault with EMCY 0x8611 and
 //   0x603F; fault reaction on the quick-stop ramp;
 // - heartbeat consumer loss: reaction per 0x6007 (1 fault, 2 disable
-//   voltage, 3 quick stop), EMCY 0x8130 from CanopenDevice.
+//   voltage, 3 quick stop), EMCY 0x8130 from CanopenDevice;
+// - velocity units: position increments per second by default (no 0x60A9,
+//   the factor group at its CiA 402 default of 1), or with rpm_units as
+//   maxon EPOS4, Nanotec and Synapticon drives come: 0x60A9 = 0x00B44700
+//   (rpm), profile velocity 0x6081 in rpm, 0x6083/0x6084/0x6085 in rpm/s,
+//   max motor speed 0x6080 in rpm (a faster 0x6081 is refused), and
+//   counts_per_rev motor position counts per revolution.
 // Predefined PDOs (CiA 402): RPDO1 = controlword only, TPDO1 = statusword
 // only, the others invalid. Units: position counts, time simulated seconds
 // in advance(). Not thread-safe.
@@ -37,11 +43,15 @@ namespace cdpr::virtual_robot {
 struct DriveDefaults {
   DeviceIdentity identity{0x00020192, 0x0000CD42, 0x00000402, 1, 0};
   std::int8_t power_on_mode = 0;             // 0x6060 at power on (1: profile position, 6: homing)
-  std::uint32_t profile_velocity = 100'000;  // 0x6081 [counts/s]
-  std::uint32_t acceleration = 1'000'000;    // 0x6083, 0x6084 [counts/s^2]
-  std::uint32_t quick_stop_deceleration = 2'000'000;  // 0x6085 [counts/s^2]
+  std::uint32_t profile_velocity = 100'000;  // 0x6081 at power on [counts/s, in the drive's units]
+  std::uint32_t acceleration = 1'000'000;    // 0x6083, 0x6084 [counts/s^2, likewise]
+  std::uint32_t quick_stop_deceleration = 2'000'000;  // 0x6085 [counts/s^2, likewise]
   double motor_max_speed = 1e9;              // what the motor can do [counts/s]
   double ack_delay_s = 0.010;                // one PDO cycle [s, real time]
+  bool rpm_units = false;                    // 0x6081.. in rpm and rpm/s (see above)
+  double counts_per_rev = 4096.0;            // rpm_units: motor position counts per revolution
+  std::uint32_t max_motor_speed_rpm = 10'000;  // rpm_units: 0x6080
+  CommunicationQuirks quirks;
 };
 
 class Cia402Device final : public CanopenDevice {
@@ -85,6 +95,8 @@ class Cia402Device final : public CanopenDevice {
   bool brake(double deceleration, double dt_s);
   void move_towards_target(double dt_s);
   std::uint16_t compose_statusword() const;
+  // 0x6081 [counts/s] or 0x6083/0x6084/0x6085 [counts/s^2] as the motion uses them.
+  double counts_per_s(std::uint16_t index) const;
 
   DriveDefaults defaults_;
   Power power_ = Power::kSwitchOnDisabled;

@@ -1,7 +1,8 @@
 #pragma once
 // A simulated CiA 406 linear/rotary encoder on a CanopenDevice: the
 // position value 0x6004 is UNSIGNED32 and wraps at the total measuring
-// range 0x6002 (a position a few counts below zero reads range - few);
+// range 0x6002 (a position a few counts below zero reads range - few),
+// counting the other way when 0x6000 bit 0 (code sequence) is set;
 // predefined TPDO1 maps 0x6004, transmission type 254 without event timer
 // until the master sets one (then it sends cyclically). Written from the
 // standard, independently of the master. Not thread-safe.
@@ -15,6 +16,9 @@ namespace cdpr::virtual_robot {
 struct EncoderDefaults {
   DeviceIdentity identity{0x00020196, 0x0000CD42, 0x00000406, 1, 0};
   std::uint32_t measuring_range = 1u << 25;  // 0x6002 [counts]
+  std::uint16_t operating_parameters = 0;     // 0x6000: bit 0 code sequence (1: counts down where 0 counts up)
+  std::uint32_t counts_per_revolution = 4096; // 0x6001
+  CommunicationQuirks quirks;
 };
 
 class Cia406Device final : public CanopenDevice {

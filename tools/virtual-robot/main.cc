@@ -74,7 +74,16 @@ int main(int argc, char** argv) {
                  "hidden load-cell bias b [N]: reading = (1 + g) * tension + b");
   app.add_option("--force-gain", options.effects.force_gain, "hidden load-cell gain error g")
       ->check(CLI::Range(-0.9, 10.0));
+  std::string quirks = "none";
+  app.add_option("--canopen-quirks", quirks,
+                 "vendor quirks the CANopen nodes play, comma-separated: two-tpdo-encoder, rtr-bit30, no-type-255, "
+                 "rpm-units (drum 0.2 m, gear 10: the daemon needs [winches.mechanics]); docs/fieldbus.md")
+      ->check([](const std::string& names) {
+        return cdpr::virtual_robot::parse_canopen_quirks(names) ? std::string() : "unknown quirk in '" + names + "'";
+      })
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  options.nodes.quirks = *cdpr::virtual_robot::parse_canopen_quirks(quirks);
   options.preset = *cdpr::sim::parse_preset(preset);
   options.report_stops = true;  // a line per stop: how far the platform swung (docs/fieldbus.md)
   options.modbus_rtu = transport == "rtu";
