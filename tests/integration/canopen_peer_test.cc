@@ -136,6 +136,10 @@ MoveFigures coordinated_move(CanopenWinchBank& bank, const drivers::MonotonicClo
       20s);
   EXPECT_TRUE(finished) << faults(bank);
   figures.duration_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  // Where the winches stopped: the encoders' PDOs after the drives said
+  // "target reached" (one came up to an event timer, 20 ms, before it,
+  // while the ramp's last 20 ms still moved 0.2 mm).
+  run_until(bank, clock, [] { return false; }, std::chrono::milliseconds(100));
   for (int i = 0; i < kWinches; ++i) {
     figures.largest_miss_m = std::max(figures.largest_miss_m, std::abs(bank.status(i).payout_m - target[i]));
   }
