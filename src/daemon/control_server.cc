@@ -156,7 +156,8 @@ ControlServer::~ControlServer() {
 void ControlServer::append_poll_fds(std::vector<pollfd>& fds) const {
   fds.push_back({listen_fd_, POLLIN, 0});
   for (const auto& client : clients_) {
-    short events = client->read_closed ? 0 : POLLIN;
+    const bool reading = !client->read_closed && client->output.size() < kReadPauseOutputBytes;
+    short events = reading ? POLLIN : 0;
     if (!client->output.empty()) events |= POLLOUT;
     fds.push_back({client->fd, events, 0});
   }
@@ -180,7 +181,8 @@ void ControlServer::service(const std::vector<pollfd>& fds) {
                                  [&](const auto& client) { return client->fd == entry.fd; });
     if (it == clients_.end()) continue;
     Client& client = **it;
-    if ((entry.revents & (POLLIN | POLLHUP | POLLERR)) && answered < kMaxRequestsPerService) {
+    if ((entry.revents & (POLLIN | POLLHUP | POLLERR)) && answered < kMaxRequestsPerService &&
+        client.output.size() < kReadPauseOutputBytes) {
       answered += read_from(client);
     }
     if (!client.output.empty()) write_to(client);

@@ -53,6 +53,11 @@ class ControlServer {
  public:
   static constexpr std::size_t kMaxClients = 128;
   static constexpr std::size_t kMaxPendingOutputBytes = 1 << 20;
+  // A client with this much of its answers unread gets no more requests
+  // read until it has read them (backpressure): a pipelining client is
+  // answered in full at its own pace, and only one whose answers pile up
+  // regardless passes kMaxPendingOutputBytes and is dropped.
+  static constexpr std::size_t kReadPauseOutputBytes = 64 << 10;
   static constexpr std::size_t kReadChunkBytes = 1024;
   static constexpr std::size_t kMaxRequestsPerService = 256;
 

@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <filesystem>
@@ -98,6 +99,41 @@ TEST(ControlServer, AnswersPipelinedRequestsInOrderOneLineEach) {
   // THEN it gets three responses, in request order
   EXPECT_EQ(drain(client), "{\"echo\":\"status\"}\n{\"echo\":\"show\"}\n{\"echo\":\"history\r\"}\n");
   EXPECT_EQ(handler.calls, 3);
+  close(client);
+}
+
+// A client that pipelines 2000 requests whose answers are 2 KiB each (a
+// status with every CANopen node's state) and reads them only later: 4 MiB
+// of answers, four times the pending-output bound. The server stops reading
+// its requests while its answers wait, so it is answered in full instead
+// of dropped as a client that never reads.
+TEST(ControlServer, APipeliningClientWithLongAnswersIsAnsweredInFull) {
+  // GIVEN a server whose answers are 2 KiB lines and a connected client
+  TempDir dir;
+  int calls = 0;
+  const auto long_answers = [&calls](std::string_view) {
+    ++calls;
+    return std::string(2047, 'a') + "\n";
+  };
+  auto server = ControlServer::listen(dir / "control", long_answers);
+  ASSERT_TRUE(server.ok()) << server.status().to_string();
+  const int client = connect_to(dir / "control");
+  ASSERT_GE(client, 0);
+  // WHEN it sends 2000 requests in one write and reads nothing while the server runs
+  std::string requests;
+  for (int n = 0; n < 2000; ++n) requests += "status\n";
+  send_text(client, requests);
+  pump(*server.value(), 40);
+  EXPECT_LT(calls, 2000) << "the server read every request while the answers piled up";
+  // THEN, reading at its own pace, it gets every answer
+  std::size_t lines = 0;
+  for (int round = 0; round < 4000 && lines < 2000; ++round) {
+    const std::string got = drain(client);
+    lines += static_cast<std::size_t>(std::count(got.begin(), got.end(), '\n'));
+    pump(*server.value(), 1);
+  }
+  EXPECT_EQ(lines, 2000u);
+  EXPECT_EQ(calls, 2000);
   close(client);
 }
 
