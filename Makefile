@@ -89,12 +89,24 @@ test: deps peer-deps all
 # (any UB is fatal, leaks fail). Built cheaper than the normal build: -O1
 # -g1 and only the test binaries (no tools, no benchmarks). CI runs it.
 SANITIZE_BUILD ?= $(BUILD)-asan
-sanitize: deps peer-deps
+SANITIZE_ENV := ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
+# CI's subset (.ci/run): every test but the slow label's (so every unit
+# test, the fuzz corpora's replays and the integration label), plus this
+# one whole daemon run; the full suite under the sanitizers would take CI
+# past its time (docs/development.md "CI's arithmetic").
+SANITIZE_CI_WHOLE_RUN := ^FullCalibration.LargeRobotSequentialReachesTheTargetWithFewerWaypoints$$
+.PHONY: sanitize-build sanitize-ci
+sanitize-build: deps peer-deps
 	cmake -S . -B $(SANITIZE_BUILD) -DCMAKE_BUILD_TYPE= "-DCMAKE_CXX_FLAGS=-O1 -g1" "-DCMAKE_C_FLAGS=-O1 -g1" \
 	  -DCDPR_WERROR=ON -DCDPR_SANITIZE=ON
 	cmake --build $(SANITIZE_BUILD) -j $(JOBS) --target test_binaries
-	cd $(SANITIZE_BUILD) && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
-	  ctest --output-on-failure -j $(JOBS)
+
+sanitize: sanitize-build
+	cd $(SANITIZE_BUILD) && $(SANITIZE_ENV) ctest --output-on-failure -j $(JOBS)
+
+sanitize-ci: sanitize-build
+	cd $(SANITIZE_BUILD) && $(SANITIZE_ENV) ctest --output-on-failure -j $(JOBS) -LE '^slow$$'
+	cd $(SANITIZE_BUILD) && $(SANITIZE_ENV) ctest --output-on-failure -R '$(SANITIZE_CI_WHOLE_RUN)'
 
 # Every libFuzzer target (tests/fuzz) for FUZZ_SECONDS each, one after the
 # other, from its seed corpus; prints execs, coverage and crashes per target.
