@@ -38,8 +38,9 @@ TEST(InterruptedRun, ADaemonKilledMidRunIsReportedAfterRestartUntilTheNextStart)
   first->signal(SIGKILL);
   ASSERT_EQ(first->wait_exit(slowed(10s)), std::optional<int>(128 + SIGKILL));
   EXPECT_TRUE(std::filesystem::exists(rig.state_dir + "/run-in-progress.toml"));
-  // (Restarted after the drives' consumer heartbeat time, 500 ms: they quick-stop on their own.)
-  std::this_thread::sleep_for(slowed(1s));
+  // (Restarted after the drives' consumer heartbeat time, 500 ms of the
+  // robot's clock, which runs slower when the robot is starved: they quick-stop on their own.)
+  RobotDeadline(rig.robot_clock(), slowed(1s)).wait();
   auto second = rig.start_daemon("second");
   ASSERT_TRUE(wait_until([&] { return rig.answers(); }, slowed(30s))) << second->log();
 

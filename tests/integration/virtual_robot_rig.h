@@ -71,6 +71,9 @@ inline daemon::DaemonConfig fast_daemon_config(const std::string& dir, const vir
   config.winches.drive.consumer_heartbeat_us = slowed_us(3'000'000);
   config.calibrator.monitor.pose_stale_us = slowed_us(3'000'000);
   config.load_cell.fault_timeout_us = slowed_us(config.load_cell.fault_timeout_us);
+  // The nodes are configured over SDO, one frame per node per loop step:
+  // a sanitized daemon's slower steps take longer to hear them operational.
+  config.calibrator.first_contact_timeout_us = slowed_us(config.calibrator.first_contact_timeout_us);
   // The winches' mechanics, as the operator knows them (drives in rpm need them).
   config.winches.mechanics.drum_diameter_m = robot.options().nodes.drum_diameter_m;
   config.winches.mechanics.gear_ratio = robot.options().nodes.gear_ratio;
