@@ -30,7 +30,6 @@ namespace {
 
 using namespace std::chrono_literals;
 using ::cdpr::test::contains;
-using Clock = std::chrono::steady_clock;
 
 bool tmpfs_mounts_allowed() { return std::system("unshare -m --propagation private true 2>/dev/null") == 0; }
 
@@ -88,11 +87,6 @@ calibctl::JsonValue poll_until(const VirtualRobotProcess& rig, const std::functi
   return status;
 }
 
-// Seconds of the robot's time since `start_us` on its clock.
-double seconds_since(const VirtualRobotProcess& rig, hal::TimeUs start_us) {
-  return 1e-3 * robot_ms_since(rig.robot_clock(), start_us);
-}
-
 // The run's end after the disk is filled now: it must fail for want of space.
 struct AfterFill {
   calibctl::JsonValue end;
@@ -104,7 +98,7 @@ AfterFill fill_and_wait_for_end(const VirtualRobotProcess& rig, const SmallDisk&
   disk.fill();
   AfterFill after;
   after.end = rig.wait_for_end(slowed(120s));
-  after.seconds = seconds_since(rig, filled_us);
+  after.seconds = 1e-3 * robot_ms_since(rig.robot_clock(), filled_us);
   after.reason = after.end["reason"].string();
   EXPECT_EQ(after.end["state"].string(), "failed") << after.reason;
   EXPECT_TRUE(contains(after.reason, "No space left on device")) << after.reason;

@@ -15,7 +15,6 @@
 namespace cdpr::integration {
 namespace {
 
-using Clock = std::chrono::steady_clock;
 using virtual_robot::LoadCellModel;
 
 struct Case {
