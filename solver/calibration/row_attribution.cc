@@ -13,7 +13,7 @@
 #include "solver/linalg/dense_kernels.h"
 #include "solver/linalg/group_kernels.h"
 #include "solver/nls/factor_parameters.h"
-#include "solver/nls/trust_region_strategy.h"
+#include "solver/nls/dense_damped_solver.h"
 
 namespace cdpr {
 namespace {
@@ -113,54 +113,41 @@ double row_residual(const Problem& full, const LocalProblem& local, int factor_i
   return residual[row];
 }
 
-void apply_step(LocalProblem& local, const Eigen::VectorXd& step) {
-  int column = 0;
-  for (int v : local.free) {
-    local.problem.retract(v, step.data() + column);
-    column += local.problem.variables()[v].tangent_dim;
-  }
-}
-
-// Levenberg-Marquardt on the row's own variables without the left-out
-// readings, its steps judged by the solver's TrustRegionStrategy; returns the
-// chi-square of the rest (infinity when it cannot be evaluated). The damping
-// starts small (the refit starts at the full fit's solution, near the
-// refit's own minimum), stays within [1e-12, 1e12] of J^T J's diagonal, and
-// the refit stops after 30 trial steps or once a step gains less than 1e-10
-// of the chi-square: what is compared across readings is the chi-square, and
-// the one left out is far above that.
-constexpr TrustRegionOptions kRefitTrustRegion{1e6, 1e12, 1e-12};
-
+// The row's own variables refitted without the left-out readings
+// (solver/nls/dense_damped_solver.h, on the pose's manifold); returns the
+// chi-square of the rest (infinity when it cannot be evaluated) and leaves
+// `local` at the refit. The damping starts small (the refit starts at the
+// full fit's solution, near the refit's own minimum) and stays within
+// [1e-12, 1e12]; the refit stops after 30 trial steps or once a step gains
+// less than 1e-10 of the chi-square: what is compared across readings is
+// the chi-square, and the one left out is far above that.
 double refit_without(const Problem& full, LocalProblem& local, const std::vector<int>& row_factors,
                      const LeftOut& left_out) {
-  constexpr int kMaxIterations = 30;
-  constexpr double kStopGain = 1e-10;
-  Linearised lin = linearise(full, local, row_factors, left_out);
-  if (!lin.ok) return std::numeric_limits<double>::infinity();
-  double chi2 = lin.residual.squaredNorm();
-  TrustRegionStrategy strategy(kRefitTrustRegion);
-  for (int it = 0; it < kMaxIterations && !strategy.collapsed(); ++it) {
-    const Eigen::MatrixXd jtj = lin.jacobian.transpose() * lin.jacobian;
-    const Eigen::VectorXd gradient = lin.jacobian.transpose() * lin.residual;
-    Eigen::MatrixXd normal = jtj;
-    normal.diagonal() += strategy.damping() * jtj.diagonal().cwiseMax(1e-9);
-    const Eigen::VectorXd step = normal.ldlt().solve(-gradient);
-    // chi2 = |r|^2: the undamped model's decrease is -(2 g's + s'J'Js).
-    const double predicted = -(2.0 * gradient.dot(step) + step.dot(jtj * step));
-    const std::vector<double> saved = local.problem.state();
-    apply_step(local, step);
-    const Linearised next = linearise(full, local, row_factors, left_out);
-    const double next_chi2 = next.ok ? next.residual.squaredNorm() : std::numeric_limits<double>::quiet_NaN();
-    if (strategy.judge_step(chi2, next_chi2, predicted)) {
-      const bool converged = chi2 - next_chi2 < kStopGain * chi2;
-      lin = next;
-      chi2 = next_chi2;
-      if (converged) break;
-    } else {
-      local.problem.state() = saved;
+  DenseDampedOptions options;
+  options.trust_region = {1e6, 1e12, 1e-12};
+  options.max_trials = 30;
+  options.gain_tolerance = 1e-10;
+  auto evaluate = [&](const std::vector<double>& state, Eigen::VectorXd& residual, Eigen::MatrixXd* jacobian) {
+    local.problem.state() = state;
+    Linearised lin = linearise(full, local, row_factors, left_out);
+    residual = std::move(lin.residual);
+    *jacobian = std::move(lin.jacobian);
+    return lin.ok;
+  };
+  auto retract = [&](const std::vector<double>& state, const Eigen::VectorXd& step, std::vector<double>& out) {
+    out = state;
+    int column = 0;
+    for (int v : local.free) {
+      local.problem.retract(v, step.data() + column, out.data());
+      column += local.problem.variables()[v].tangent_dim;
     }
-  }
-  return chi2;
+  };
+  std::vector<double> state = local.problem.state();
+  DenseDampedSolver<Eigen::Dynamic, Eigen::Dynamic> solver(options);
+  const DenseDampedSummary summary = solver.minimize_on_manifold(state, evaluate, retract);
+  local.problem.state() = state;
+  if (summary.stop == DenseDampedStop::kNotEvaluable) return std::numeric_limits<double>::infinity();
+  return summary.final_chi2;
 }
 
 // Two choices of readings to leave out are told apart when one explains

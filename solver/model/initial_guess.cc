@@ -8,7 +8,7 @@
 
 #include "solver/model/catenary.h"
 #include "solver/model/platform_statics.h"
-#include "solver/nls/trust_region_strategy.h"
+#include "solver/nls/dense_damped_solver.h"
 
 namespace cdpr {
 
@@ -132,63 +132,21 @@ class TurnedForceMaps {
   int last_used_ = 0;
 };
 
-// Levenberg-Marquardt on the fit's residuals over N unknowns x, its steps
-// judged and its damping set by the solver's TrustRegionStrategy: a trial
-// minimises the model with the normal matrix's diagonal scaled by
-// 1 + 1/radius. It stops when a step gains less than kStopGain of the cost,
-// and, without evaluating, once the model predicts no more than that: near
-// the minimum rounding would refuse trial after trial. At most 50 trials.
-//
-// `evaluate(x, residual, jacobian)` is false outside the model;
-// `propose(x, H, g)` gives the trial point from the damped normal matrix H
-// and gradient g. False when the start x cannot be evaluated; else x is the
-// best point found.
-// A start needs its forces and heading near their minimum, not at it: the
-// calibration refines them with everything else, and with the anchors
-// metres off Gauss-Newton converges only linearly here, so the stop is
-// loose (the calibration's result does not depend on the digits beyond it).
-constexpr double kStopGain = 1e-7;
-
-// Damping 1e-3 at the start, never below 1e-9, given up above 1e12.
-constexpr TrustRegionOptions kStartTrustRegion{1e3, 1e9, 1e-12};
-
-template <int N, typename Evaluate, typename Propose>
-bool damped_gauss_newton(Eigen::Matrix<double, N, 1>& x, const Evaluate& evaluate, const Propose& propose) {
-  using Vector = Eigen::Matrix<double, N, 1>;
-  using Jacobian = Eigen::Matrix<double, kFitRows, N>;
-  FitResiduals residual, trial_residual;
-  Jacobian jacobian, trial_jacobian;
-  if (!evaluate(x, residual, jacobian)) return false;
-  double cost = residual.squaredNorm();
-  TrustRegionStrategy strategy(kStartTrustRegion);
-  for (int iteration = 0; iteration < 50 && !strategy.collapsed(); ++iteration) {
-    const Vector gradient = jacobian.transpose() * residual;
-    const Eigen::Matrix<double, N, N> jtj = jacobian.transpose() * jacobian;
-    // H = J'J with its diagonal times 1 + damping, as one whole-matrix
-    // expression (every other entry times exactly 1): scaling H's diagonal
-    // in place stores it an entry at a time, and the LDLT in `propose`
-    // reloads H two entries at a time, a load the CPU cannot forward from
-    // those stores; it waits for them to reach the cache.
-    static const Eigen::Array<double, N, N> kIdentity = Eigen::Matrix<double, N, N>::Identity().array();
-    const Eigen::Matrix<double, N, N> H = (jtj.array() * (1.0 + strategy.damping() * kIdentity)).matrix();
-    const Vector trial = propose(x, H, gradient);
-    const Vector step = trial - x;
-    // The cost is |r|^2: the undamped model's decrease is -(2 g's + s'J'Js).
-    const double predicted = -(2.0 * gradient.dot(step) + step.dot(jtj * step));
-    if (!(predicted > kStopGain * (1.0 + cost))) break;
-    const double trial_cost = evaluate(trial, trial_residual, trial_jacobian)
-                                  ? trial_residual.squaredNorm()
-                                  : std::numeric_limits<double>::quiet_NaN();
-    if (strategy.judge_step(cost, trial_cost, predicted)) {
-      const bool converged = cost - trial_cost < kStopGain * (1.0 + cost);
-      x = trial;
-      residual = trial_residual;
-      jacobian = trial_jacobian;
-      cost = trial_cost;
-      if (converged) break;
-    }
-  }
-  return true;
+// The start's small fits (solver/nls/dense_damped_solver.h) on the
+// whitened height and force rows. A start needs its forces and heading near
+// their minimum, not at it: the calibration refines them with everything
+// else, and with the anchors metres off Gauss-Newton converges only
+// linearly here, so the stop is loose (a gain below 1e-7 of 1 + chi2; the
+// calibration's result does not depend on the digits beyond it). The
+// damping starts at 1e-3, never falls below 1e-9 and is given up above
+// 1e12; at most 50 trials.
+DenseDampedOptions start_fit_options() {
+  DenseDampedOptions options;
+  options.trust_region = {1e3, 1e9, 1e-12};
+  options.max_trials = 50;
+  options.gain_tolerance = 1e-7;
+  options.gain_floor = 1.0;
+  return options;
 }
 
 }  // namespace
@@ -223,15 +181,12 @@ std::optional<Eigen::Vector2d> refine_reference_force(const Robot& robot, const 
   // Only the height and force rows constrain the force; encoder rows carry
   // the still unknown offsets. The pose and anchors are fixed, so the
   // statics are factorised once and each trial costs four catenaries.
-  auto evaluate = [&](const Eigen::Vector2d& force, FitResiduals& residual, FitJacobian& jacobian) {
-    return height_and_force(robot, map, sample, force, sigma_height_m, residual, &jacobian);
+  auto evaluate = [&](const Eigen::Vector2d& force, FitResiduals& residual, FitJacobian* jacobian) {
+    return height_and_force(robot, map, sample, force, sigma_height_m, residual, jacobian);
   };
   Eigen::Vector2d force = guess;
-  const bool evaluable = damped_gauss_newton<2>(
-      force, evaluate, [](const Eigen::Vector2d& x, const Eigen::Matrix2d& H, const Eigen::Vector2d& gradient) {
-        return Eigen::Vector2d(x - H.ldlt().solve(gradient));
-      });
-  if (!evaluable) return std::nullopt;
+  DenseDampedSolver<kFitRows, 2> solver(start_fit_options());
+  if (solver.minimize(force, evaluate).stop == DenseDampedStop::kNotEvaluable) return std::nullopt;
   return force;
 }
 
@@ -295,26 +250,18 @@ std::optional<ForceAndHeading> refine_reference_force_and_heading(
     if (tension > 0.0) jacobian.block<1, 2>(kCableCount, 0) = force.transpose() / (tension * sigma_force);
     return true;
   };
-  // The unknowns as one vector (f_h, f_v, yaw).
-  auto evaluate_at = [&](const Eigen::Vector3d& x, FitResiduals& residual, Jacobian3& jacobian) {
-    return evaluate(x.head<2>(), x(2), residual, jacobian);
+  // The unknowns as one vector (f_h, f_v, yaw), the heading within its
+  // bounds: a step that would cross one stops the heading on it, and the
+  // forces take the model's best step for that turn (clamping the heading
+  // alone kept forces fitted to a far larger turn).
+  auto evaluate_at = [&](const Eigen::Vector3d& x, FitResiduals& residual, Jacobian3* jacobian) {
+    return evaluate(x.head<2>(), x(2), residual, *jacobian);
   };
   Eigen::Vector3d x(guess.x(), guess.y(), std::clamp(yaw_guess_rad, yaw_min_rad, yaw_max_rad));
-  auto propose = [&](const Eigen::Vector3d& current, const Eigen::Matrix3d& H, const Eigen::Vector3d& gradient) {
-    Eigen::Vector3d step = -H.ldlt().solve(gradient);
-    const double yaw = current(2);
-    // A step that would cross a bound stops the heading on it, and the forces
-    // take the model's best step for that turn: the minimum of the quadratic
-    // model with the heading fixed (clamping the heading alone kept forces
-    // fitted to a far larger turn).
-    const double bounded = std::clamp(yaw + step(2), yaw_min_rad, yaw_max_rad);
-    if (bounded != yaw + step(2)) {
-      step(2) = bounded - yaw;
-      step.head<2>() = -H.topLeftCorner<2, 2>().ldlt().solve(gradient.head<2>() + H.block<2, 1>(0, 2) * step(2));
-    }
-    return Eigen::Vector3d(current(0) + step(0), current(1) + step(1), bounded);
-  };
-  if (!damped_gauss_newton<3>(x, evaluate_at, propose)) return std::nullopt;
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  DenseDampedSolver<kFitRows, 3> solver(start_fit_options());
+  solver.set_bounds({-kInfinity, -kInfinity, yaw_min_rad}, {kInfinity, kInfinity, yaw_max_rad});
+  if (solver.minimize(x, evaluate_at).stop == DenseDampedStop::kNotEvaluable) return std::nullopt;
   return ForceAndHeading{x.head<2>(), x(2)};
 }
 

@@ -45,8 +45,8 @@ std::optional<ReferenceForceMap> sample_force_map(const Robot& robot,
                                                   const Sample& sample);
 
 // Refines (f_h, f_v) of the reference cable at one pose, anchors held fixed,
-// by damped Gauss-Newton on the height (Eq. 15) and force (Eq. 16)
-// residuals, starting from `guess`. Empty when the statics cannot be
+// by the small damped solver (solver/nls/dense_damped_solver.h) on the
+// height (Eq. 15) and force (Eq. 16) residuals, starting from `guess`. Empty when the statics cannot be
 // evaluated near the guess (e.g. a cable would push).
 std::optional<Eigen::Vector2d> refine_reference_force(const Robot& robot,
                                                       const std::array<Eigen::Vector3d, kCableCount>& anchors,
@@ -59,7 +59,7 @@ std::optional<Eigen::Vector2d> refine_reference_force(const Robot& robot, const 
                                                       double sigma_height_m);
 
 // Refines the reference force and the heading together (anchors held
-// fixed): the same damped Gauss-Newton over (f_h, f_v, yaw), yaw a turn of
+// fixed): the same damped solve over (f_h, f_v, yaw), yaw a turn of
 // the measured pose about the world vertical through the platform origin,
 // kept in [yaw_min_rad, yaw_max_rad], starting from `guess` at
 // `yaw_guess_rad`. Every accepted point is evaluable (all cables pull).

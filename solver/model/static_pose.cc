@@ -6,21 +6,16 @@
 #include <optional>
 #include <utility>
 
-#include <Eigen/Cholesky>
-
 #include "solver/model/cable_prediction.h"
 #include "solver/model/initial_guess.h"
 #include "solver/model/sample.h"
-#include "solver/nls/trust_region_strategy.h"
+#include "solver/nls/dense_damped_solver.h"
 
 namespace cdpr {
 namespace {
 
 constexpr int kMaxIterations = 200;  // trial steps
 constexpr double kHeightToleranceM = 1e-9;
-// Bounds of the damping's diagonal, as the calibration's solver.
-constexpr double kMinDiagonal = 1e-6;
-constexpr double kMaxDiagonal = 1e32;
 
 using Unknowns = Eigen::Vector4d;  // roll [rad], pitch [rad], f_h [N], f_v [N]
 
@@ -66,53 +61,28 @@ std::optional<StaticPose> solve_static_pose(const Robot& robot, const std::array
   Unknowns u;
   u << 0.0, 0.0, paper_reference_force_guess(robot, anchors, level);
 
-  auto r = residuals(robot, anchors, position_world, u);
-  if (!r) return fail("no equilibrium near the level pose (a cable would push or statics singular)");
   // Levenberg-Marquardt on the four height residuals (a square system: its
-  // least-squares minimum is the root). The initial radius makes the first
-  // steps nearly Newton's; the strategy damps them where the statics turn
-  // sharply or a trial leaves the model (a cable would push).
-  TrustRegionStrategy strategy;
-  double cost = 0.5 * r->squaredNorm();
-  for (int iteration = 0;
-       iteration < kMaxIterations && r->cwiseAbs().maxCoeff() > kHeightToleranceM && !strategy.collapsed();
-       ++iteration) {
-    // Central differences: angles step 1e-6 rad, forces relative 1e-6.
-    Eigen::Matrix4d jacobian;
-    for (int j = 0; j < 4; ++j) {
-      const double h = j < 2 ? 1e-6 : 1e-6 * std::max(1.0, std::abs(u(j)));
-      Unknowns plus = u, minus = u;
-      plus(j) += h;
-      minus(j) -= h;
-      const auto r_plus = residuals(robot, anchors, position_world, plus);
-      const auto r_minus = residuals(robot, anchors, position_world, minus);
-      if (!r_plus || !r_minus) return fail("statics fail next to the iterate");
-      jacobian.col(j) = (*r_plus - *r_minus) / (2.0 * h);
-    }
-    const Eigen::Matrix4d jtj = jacobian.transpose() * jacobian;
-    const Eigen::Vector4d gradient = jacobian.transpose() * *r;
-    Eigen::Matrix4d damped = jtj;
-    damped.diagonal() += jtj.diagonal().cwiseMax(kMinDiagonal).cwiseMin(kMaxDiagonal) / strategy.radius();
-    const Eigen::LDLT<Eigen::Matrix4d> ldlt(damped);
-    if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) {
-      strategy.reject_step();
-      continue;
-    }
-    const Unknowns step = -ldlt.solve(gradient);
-    const double predicted = -(gradient.dot(step) + 0.5 * step.dot(jtj * step));
-    const Unknowns trial = u + step;
-    const auto r_trial = predicted > 0.0 ? residuals(robot, anchors, position_world, trial) : std::nullopt;
-    const double trial_cost = r_trial ? 0.5 * r_trial->squaredNorm() : std::numeric_limits<double>::quiet_NaN();
-    if (strategy.judge_step(cost, trial_cost, predicted)) {
-      u = trial;
-      r = r_trial;
-      cost = trial_cost;
-    }
+  // least-squares minimum is the root), Jacobian by central differences
+  // (angles step 1e-6 rad, forces relative 1e-6). The initial radius makes
+  // the first steps nearly Newton's; the damping rises where the statics
+  // turn sharply or a trial leaves the model (a cable would push).
+  DenseDampedOptions options;
+  options.max_trials = kMaxIterations;
+  options.residual_tolerance = kHeightToleranceM;
+  DenseDampedSolver<4, 4> solver(options);
+  const DenseDampedSummary summary = solver.minimize_numeric(u, [&](const Unknowns& at, Eigen::Vector4d& r) {
+    const std::optional<Eigen::Vector4d> heights = residuals(robot, anchors, position_world, at);
+    if (heights) r = *heights;
+    return heights.has_value();
+  });
+  if (summary.stop == DenseDampedStop::kNotEvaluable) {
+    return fail("no equilibrium near the level pose (a cable would push or statics singular)");
   }
+  if (summary.stop == DenseDampedStop::kJacobianNotEvaluable) return fail("statics fail next to the iterate");
 
   StaticPose result;
   std::array<CablePrediction, kCableCount> cables;
-  r = residuals(robot, anchors, position_world, u, &cables);
+  const std::optional<Eigen::Vector4d> r = residuals(robot, anchors, position_world, u, &cables);
   if (!r) return fail("statics fail at the solution");
   result.height_residual_m = r->cwiseAbs().maxCoeff();
   if (!(result.height_residual_m < 1e-6)) {

@@ -31,8 +31,8 @@ struct StaticPose {
   double height_residual_m = 0.0;  // max |catenary end height - attachment height| at the solution
 };
 
-// Solves as above by Levenberg-Marquardt (the solver's trust-region
-// strategy) with a finite-difference Jacobian. Empty when there is no
+// Solves as above by the small damped solver
+// (solver/nls/dense_damped_solver.h) with a central-difference Jacobian. Empty when there is no
 // equilibrium; *why (if given) then says why (a cable would push, the
 // statics fail, no convergence).
 std::optional<StaticPose> solve_static_pose(const Robot& robot, const std::array<Eigen::Vector3d, kCableCount>& anchors,
