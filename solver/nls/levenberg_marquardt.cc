@@ -238,118 +238,179 @@ struct LevenbergMarquardt::Impl {
     return true;
   }
 
+  // The steps of solve(), in the order they run; all but not_evaluable()
+  // and summarize(), which run outside the loop, allocation-free.
+  enum class Stop { kNone, kGradient, kFunction, kParameter, kCollapsed, kFatal, kNoVariables };
+  // Where the loop stands between its steps.
+  struct Iterate {
+    double cost = 0.0;
+    double last_relative_decrease = 0.0;  // |d cost| / cost of the last candidate judged
+    double last_step_norm = 0.0;          // |dx| of a step below parameter_tolerance
+    int successful_steps = 0;
+  };
+  SolverSummary not_evaluable(int failed) const;
+  Stop iterate(TrustRegionStrategy& strategy, Iterate& at, IterationSummary& it);
+  FactorizationStatus solve_damped_system(double radius, double* step_norm);
+  bool step_is_negligible(double step_norm) const;
+  double predicted_decrease(double radius) const;
+  double evaluate_candidate(double predicted);
+  void accept_candidate(double new_cost, Iterate& at, IterationSummary& it);
+  Stop convergence_test(bool accepted, double old_cost, double new_cost, Iterate& at) const;
+  SolverSummary summarize(Stop stop, int iterations, const Iterate& at, const TrustRegionStrategy& strategy,
+                          SolverSummary summary);
+
   SolverSummary solve();
 };
 
 SolverSummary LevenbergMarquardt::Impl::solve() {
-  SolverSummary summary;
   if (problem.state().size() != candidate.size()) die("the problem's structure changed after the solver was built");
-
+  Iterate at;
   int failed = -1;
-  double cost = 0.0;
-  if (!linearize(&cost, &failed)) {
-    summary.termination = TerminationType::kNotEvaluable;
-    const auto keys = problem.factors()[failed]->keys();
-    summary.message = "factor " + std::to_string(failed) + " (first variable " +
-                      (keys.empty() ? std::string("none") : to_string(keys[0])) +
-                      ") cannot be evaluated at the initial point";
-    return summary;
-  }
-  summary.initial_cost = summary.final_cost = cost;
+  if (!linearize(&at.cost, &failed)) return not_evaluable(failed);
+  SolverSummary summary;
+  summary.initial_cost = at.cost;
 
   IterationSummary it;
-  it.cost = cost;
+  it.cost = at.cost;
   it.gradient_max_norm = max_abs(gradient);
   it.trust_radius = options.initial_trust_radius;
   if (options.progress) options.progress(it);
 
-  // Everything below up to the end of the loop is the hot path: no
-  // allocation (tests/solver/nls/lm_allocation_test.cc counts them). Messages are
-  // composed after the loop from these numbers.
-  enum class Stop { kNone, kGradient, kFunction, kParameter, kCollapsed, kFatal, kNoVariables };
+  // From here to summarize() is the hot path: no allocation
+  // (tests/solver/nls/lm_allocation_test.cc counts them); messages are
+  // composed afterwards from the numbers.
   Stop stop = Stop::kNone;
   if (system->columns() == 0) stop = Stop::kNoVariables;
   else if (it.gradient_max_norm <= options.gradient_tolerance) stop = Stop::kGradient;
   TrustRegionStrategy strategy({options.initial_trust_radius, options.max_trust_radius, options.min_trust_radius});
-  double last_relative_decrease = 0.0, last_step_norm = 0.0;
   int iteration = 0;
   while (stop == Stop::kNone && iteration < options.max_iterations) {
-    ++iteration;
     it = IterationSummary{};
-    it.iteration = iteration;
-
-    const double radius = strategy.radius();
-    const FactorizationStatus status = system->factorize(radius, nullptr);
-    if (status == FactorizationStatus::kFatal) {
-      stop = Stop::kFatal;
-      break;
-    }
-    bool accepted = false;
-    if (status != FactorizationStatus::kSuccess) {
-      strategy.reject_step();
-    } else {
-      for (int c = 0; c < columns(); ++c) rhs[c] = -gradient[c];
-      system->solve(rhs.data(), step.data());
-      it.step_norm = norm(step);
-      const double x_norm = free_state_norm();
-      if (it.step_norm <= (x_norm + options.parameter_tolerance) * options.parameter_tolerance) {
-        stop = Stop::kParameter;
-        last_step_norm = it.step_norm;
-      } else {
-        // Predicted decrease of the undamped model, -(g'dx + 0.5 dx'J'J dx),
-        // is 0.5 (dx'D dx / radius - g'dx) for the dx that solves
-        // (J'J + D / radius) dx = -g (Madsen, Nielsen, Tingleff, "Methods for
-        // non-linear least squares problems", 2004, Eq. 3.9b): O(columns)
-        // instead of a product with J'J.
-        double g_dx = 0.0;
-        for (int c = 0; c < columns(); ++c) g_dx += gradient[c] * step[c];
-        const double predicted = 0.5 * (system->damping_quadratic(step.data(), radius) - g_dx);
-        const int other = 1 - slot;
-        double new_cost = std::numeric_limits<double>::quiet_NaN();
-        if (predicted > 0.0) {
-          make_candidate();
-          if (!system->evaluate(candidate.data(), other, &new_cost, &failed)) {
-            new_cost = std::numeric_limits<double>::quiet_NaN();
-          }
-        }
-        // Not evaluable, no model decrease or too small a gain: the strategy
-        // shrinks the trust region (raises the damping).
-        accepted = strategy.judge_step(cost, new_cost, predicted);
-        if (accepted) {
-          const double actual = cost - new_cost;
-          std::copy(candidate.begin(), candidate.end(), problem.state().begin());
-          slot = other;
-          system->accumulate(slot, gradient.data());
-          last_relative_decrease = std::abs(actual) / cost;
-          it.cost_change = actual;
-          cost = new_cost;
-          ++summary.successful_steps;
-          if (last_relative_decrease <= options.function_tolerance) stop = Stop::kFunction;
-        } else if (std::abs(cost - new_cost) <= options.function_tolerance * cost) {
-          // A refused candidate that changes the cost by no more than the
-          // tolerance: the cost is flat to within it here (at a minimum,
-          // its rounding decides the gain ratio), and shrinking the region
-          // would only try shorter steps of the same nothing. Ceres ends
-          // its solve on such a candidate too. NaN (not evaluable) fails
-          // the test.
-          last_relative_decrease = std::abs(cost - new_cost) / cost;
-          stop = Stop::kFunction;
-        }
-      }
-    }
-    if (!accepted && stop == Stop::kNone && strategy.collapsed()) stop = Stop::kCollapsed;
-    it.cost = cost;
-    it.gradient_max_norm = max_abs(gradient);
-    it.trust_radius = strategy.radius();
-    it.step_accepted = accepted;
-    if (accepted && stop == Stop::kNone && it.gradient_max_norm <= options.gradient_tolerance) stop = Stop::kGradient;
+    it.iteration = ++iteration;
+    stop = iterate(strategy, at, it);
+    if (stop == Stop::kFatal) break;
     if (options.progress) options.progress(it);
   }
-
   // `slot` holds the factors at the values the loop leaves.
-  note_linearized(cost);
-  summary.iterations = iteration;
-  summary.final_cost = cost;
+  note_linearized(at.cost);
+  return summarize(stop, iteration, at, strategy, summary);
+}
+
+// One iteration: solve the damped system, evaluate the candidate, accept
+// or refuse it (the strategy updates the radius), test for convergence.
+LevenbergMarquardt::Impl::Stop LevenbergMarquardt::Impl::iterate(TrustRegionStrategy& strategy, Iterate& at,
+                                                                 IterationSummary& it) {
+  const double radius = strategy.radius();
+  const FactorizationStatus status = solve_damped_system(radius, &it.step_norm);
+  if (status == FactorizationStatus::kFatal) return Stop::kFatal;
+  bool accepted = false;
+  Stop stop = Stop::kNone;
+  if (status != FactorizationStatus::kSuccess) {
+    strategy.reject_step();  // not positive definite: raise the damping
+  } else if (step_is_negligible(it.step_norm)) {
+    at.last_step_norm = it.step_norm;
+    stop = Stop::kParameter;
+  } else {
+    const double predicted = predicted_decrease(radius);
+    const double old_cost = at.cost;
+    const double new_cost = evaluate_candidate(predicted);
+    // Not evaluable, no model decrease or too small a gain: the strategy
+    // shrinks the trust region (raises the damping).
+    accepted = strategy.judge_step(old_cost, new_cost, predicted);
+    if (accepted) accept_candidate(new_cost, at, it);
+    stop = convergence_test(accepted, old_cost, new_cost, at);
+  }
+  if (stop == Stop::kNone && !accepted && strategy.collapsed()) stop = Stop::kCollapsed;
+  it.cost = at.cost;
+  it.gradient_max_norm = max_abs(gradient);
+  it.trust_radius = strategy.radius();
+  it.step_accepted = accepted;
+  if (accepted && stop == Stop::kNone && it.gradient_max_norm <= options.gradient_tolerance) stop = Stop::kGradient;
+  return stop;
+}
+
+// (J^T J + D / radius) dx = -g into `step`; its norm when solved.
+FactorizationStatus LevenbergMarquardt::Impl::solve_damped_system(double radius, double* step_norm) {
+  const FactorizationStatus status = system->factorize(radius, nullptr);
+  if (status != FactorizationStatus::kSuccess) return status;
+  for (int c = 0; c < columns(); ++c) rhs[c] = -gradient[c];
+  system->solve(rhs.data(), step.data());
+  *step_norm = norm(step);
+  return status;
+}
+
+bool LevenbergMarquardt::Impl::step_is_negligible(double step_norm) const {
+  return step_norm <= (free_state_norm() + options.parameter_tolerance) * options.parameter_tolerance;
+}
+
+// Predicted decrease of the undamped model, -(g'dx + 0.5 dx'J'J dx), is
+// 0.5 (dx'D dx / radius - g'dx) for the dx that solves
+// (J'J + D / radius) dx = -g (Madsen, Nielsen, Tingleff, "Methods for
+// non-linear least squares problems", 2004, Eq. 3.9b): O(columns) instead
+// of a product with J'J.
+double LevenbergMarquardt::Impl::predicted_decrease(double radius) const {
+  double g_dx = 0.0;
+  for (int c = 0; c < columns(); ++c) g_dx += gradient[c] * step[c];
+  return 0.5 * (system->damping_quadratic(step.data(), radius) - g_dx);
+}
+
+// The cost at state boxplus step, evaluated into the other slot; NaN when
+// a factor cannot be evaluated there or the model predicts no decrease.
+double LevenbergMarquardt::Impl::evaluate_candidate(double predicted) {
+  double new_cost = std::numeric_limits<double>::quiet_NaN();
+  if (!(predicted > 0.0)) return new_cost;
+  make_candidate();
+  int failed = -1;
+  if (!system->evaluate(candidate.data(), 1 - slot, &new_cost, &failed)) {
+    new_cost = std::numeric_limits<double>::quiet_NaN();
+  }
+  return new_cost;
+}
+
+// The candidate becomes the state; its slot and gradient the current ones.
+void LevenbergMarquardt::Impl::accept_candidate(double new_cost, Iterate& at, IterationSummary& it) {
+  std::copy(candidate.begin(), candidate.end(), problem.state().begin());
+  slot = 1 - slot;
+  system->accumulate(slot, gradient.data());
+  it.cost_change = at.cost - new_cost;
+  at.cost = new_cost;
+  ++at.successful_steps;
+}
+
+// After a judged candidate: converged when it changed the cost by no more
+// than function_tolerance relative. A refused candidate that changes the
+// cost that little means the cost is flat to within it here (at a minimum
+// its rounding decides the gain ratio), and shrinking the region would only
+// try shorter steps of the same nothing; Ceres ends its solve on such a
+// candidate too. NaN (not evaluable) fails the test.
+LevenbergMarquardt::Impl::Stop LevenbergMarquardt::Impl::convergence_test(bool accepted, double old_cost,
+                                                                          double new_cost, Iterate& at) const {
+  const double change = std::abs(old_cost - new_cost);
+  if (accepted) {
+    at.last_relative_decrease = change / old_cost;
+    return at.last_relative_decrease <= options.function_tolerance ? Stop::kFunction : Stop::kNone;
+  }
+  if (!(change <= options.function_tolerance * old_cost)) return Stop::kNone;
+  at.last_relative_decrease = change / old_cost;
+  return Stop::kFunction;
+}
+
+SolverSummary LevenbergMarquardt::Impl::not_evaluable(int failed) const {
+  SolverSummary summary;
+  summary.termination = TerminationType::kNotEvaluable;
+  const auto keys = problem.factors()[failed]->keys();
+  summary.message = "factor " + std::to_string(failed) + " (first variable " +
+                    (keys.empty() ? std::string("none") : to_string(keys[0])) +
+                    ") cannot be evaluated at the initial point";
+  return summary;
+}
+
+// The summary of a finished loop: why it stopped, in words and figures.
+SolverSummary LevenbergMarquardt::Impl::summarize(Stop stop, int iterations, const Iterate& at,
+                                                  const TrustRegionStrategy& strategy, SolverSummary summary) {
+  summary.iterations = iterations;
+  summary.final_cost = at.cost;
+  summary.successful_steps = at.successful_steps;
   char buffer[160];
   switch (stop) {
     case Stop::kNone:
@@ -368,11 +429,11 @@ SolverSummary LevenbergMarquardt::Impl::solve() {
     case Stop::kFunction:
       summary.termination = TerminationType::kConverged;
       std::snprintf(buffer, sizeof buffer, "function tolerance reached: |d cost| / cost = %.3e <= %.3e",
-                    last_relative_decrease, options.function_tolerance);
+                    at.last_relative_decrease, options.function_tolerance);
       break;
     case Stop::kParameter:
       summary.termination = TerminationType::kConverged;
-      std::snprintf(buffer, sizeof buffer, "parameter tolerance reached: |dx| = %.3e", last_step_norm);
+      std::snprintf(buffer, sizeof buffer, "parameter tolerance reached: |dx| = %.3e", at.last_step_norm);
       break;
     case Stop::kCollapsed:
       summary.termination = TerminationType::kTrustRegionCollapsed;
