@@ -6,6 +6,7 @@
 #include <limits>
 #include <optional>
 
+#include "solver/calibration/calibration_stages.h"
 #include "solver/calibration/gross_errors.h"
 #include "solver/calibration/model_fit_check.h"
 #include "solver/calibration/noise_components.h"
@@ -50,10 +51,26 @@ CalibrationResult calibrate_with_restart(const Robot& robot, const std::vector<S
   };
   CalibrationResult first = calibrate_once(robot, samples, options);
   if (usable(first) || options.cable_model != CableModelKind::kCatenary) return first;
-  auto restart_from = [&](const CalibrationResult& coarse) {
-    Robot restart = robot;
-    for (int i = 0; i < kCableCount; ++i) restart.winches[i].anchor_world = coarse.calibration.winches[i].anchor_world;
-    return calibrate_once(restart, samples, options);
+  std::string why = "from the nominal anchors: " + first.message;
+  // One fallback: a fit with `start_options` whose anchors start the fit
+  // asked for; that fit when usable. `failed` and `after` name it in `why`.
+  auto restart = [&](const char* name, const CalibrationOptions& start_options, const char* failed,
+                     const char* after) -> std::optional<CalibrationResult> {
+    StageScope stage(name, true);
+    const CalibrationResult start = calibrate_once(robot, samples, start_options);
+    if (start.calibration.winches.empty()) {
+      why += std::string("; ") + failed + start.message;
+      stage.finish("not kept: the fit for its start failed: " + start.message);
+      return std::nullopt;
+    }
+    CalibrationResult fit = calibrate_once(started_at(robot, start), samples, options);
+    if (!usable(fit)) {
+      why += std::string("; ") + after + fit.message;
+      stage.finish("not kept: " + fit.message);
+      return std::nullopt;
+    }
+    stage.finish("kept");
+    return fit;
   };
   // A tight Eq. (15) makes the cost landscape narrow; far from the solution
   // LM can stall where the anchors are unobservable. Continuation: solve with
@@ -61,34 +78,23 @@ CalibrationResult calibrate_with_restart(const Robot& robot, const std::vector<S
   // with the requested one from there.
   CalibrationOptions loose = options;
   loose.height_sigma_m *= 10.0;
-  const CalibrationResult coarse = calibrate_once(robot, samples, loose);
-  std::string why = "from the nominal anchors: " + first.message;
-  if (!coarse.calibration.winches.empty()) {
-    CalibrationResult second = restart_from(coarse);
-    if (usable(second)) {
-      second.message += " (after a restart with a looser height consistency: the first solve stopped where the "
-                        "anchors were unobservable)";
-      return second;
-    }
-    why += "; after a looser height consistency: " + second.message;
-  } else {
-    why += "; with a looser height consistency: " + coarse.message;
+  if (std::optional<CalibrationResult> second =
+          restart("restart with a ten times looser height consistency", loose, "with a looser height consistency: ",
+                  "after a looser height consistency: ")) {
+    second->message += " (after a restart with a looser height consistency: the first solve stopped where the "
+                       "anchors were unobservable)";
+    return *second;
   }
   // Straight cables have no sag to start and converge from farther away: a
   // rigid fit's anchors as the start.
   CalibrationOptions rigid = options;
   rigid.cable_model = CableModelKind::kRigid;
   rigid.effects.clear();
-  const CalibrationResult straight = calibrate_once(robot, samples, rigid);
-  if (!straight.calibration.winches.empty()) {
-    CalibrationResult third = restart_from(straight);
-    if (usable(third)) {
-      third.message += " (started from a rigid fit's anchors: " + why + ")";
-      return third;
-    }
-    why += "; from a rigid fit's anchors: " + third.message;
-  } else {
-    why += "; the rigid fit for a start failed too: " + straight.message;
+  if (std::optional<CalibrationResult> third = restart("restart from a rigid fit's anchors", rigid,
+                                                       "the rigid fit for a start failed too: ",
+                                                       "from a rigid fit's anchors: ")) {
+    third->message += " (started from a rigid fit's anchors: " + why + ")";
+    return *third;
   }
   if (first.gross_errors.empty()) first.message = "no start converged (" + why + ")";
   return first;
@@ -142,7 +148,11 @@ CalibrationResult refit_without(const Robot& robot, const std::vector<Sample>& s
   for (const SensorReading& r : robust.gross_errors) {
     if (std::isfinite(r.value)) flagged.push_back(r);
   }
-  if (auto refused = refusal(flagged)) return *refused;
+  StageScope stage("refit without the gross errors", false);
+  if (auto refused = refusal(flagged)) {
+    stage.finish("refused: " + refused->message);
+    return *refused;
+  }
   const std::vector<Sample> kept = leave_out(samples, robust.gross_errors, options.cable_model);
   Robot restart = robot;
   for (int i = 0; i < kCableCount; ++i) restart.winches[i].anchor_world = robust.calibration.winches[i].anchor_world;
@@ -159,6 +169,10 @@ CalibrationResult refit_without(const Robot& robot, const std::vector<Sample>& s
       refit.degrees_of_freedom > 0 ? std::max(1.0, std::sqrt(refit.chi_square / refit.degrees_of_freedom)) : 1.0;
   const std::vector<SensorReading> confirmed = confirm_left_out(
       robust.gross_errors, refit.left_out_residuals, refit.ok, options.rejection_threshold_sigma * misfit_scale);
+  record_stage("final test of the readings left out",
+               std::to_string(robust.gross_errors.size() - confirmed.size()) + " of " +
+                   std::to_string(robust.gross_errors.size()) + " predicted within the threshold: put back" +
+                   (confirmed.size() < robust.gross_errors.size() ? ", fit redone" : ""));
   if (confirmed.size() < robust.gross_errors.size()) {
     // A failed refit has no anchors: the robust fit's stay the start.
     if (has_anchors(refit)) {
@@ -166,10 +180,15 @@ CalibrationResult refit_without(const Robot& robot, const std::vector<Sample>& s
     }
     refit = calibrate_with_restart(restart, leave_out(samples, confirmed, options.cable_model), plain);
   }
-  if (auto refused = refusal(confirmed)) return *refused;
+  if (auto refused = refusal(confirmed)) {
+    stage.finish("refused: " + refused->message);
+    return *refused;
+  }
   refit.gross_errors = confirmed;
   refit.calibration.rejected = confirmed;
   if (refit.ok) note_left_out(refit);
+  stage.finish(std::to_string(confirmed.size()) + " readings left out; " +
+               (refit.ok ? "fit ok" : "fit failed: " + refit.message));
   return refit;
 }
 
@@ -181,9 +200,11 @@ CalibrationResult refit_without(const Robot& robot, const std::vector<Sample>& s
 // final test in refit_without puts back those the refit predicts within the
 // threshold. Nothing when the set is large or no hypothesis brings the
 // flagged rows within the allowed fraction.
+// `fallback`: run because the fit flagged too many rows (not to challenge a fit).
 std::optional<CalibrationResult> consensus_start(const Robot& robot, const std::vector<Sample>& samples,
-                                                 const CalibrationOptions& options) {
+                                                 const CalibrationOptions& options, bool fallback) {
   if (samples.size() > kSmallSetRows || samples.size() < 3) return std::nullopt;
+  StageScope stage("row hypotheses: each row left out in turn", fallback, StageScope::Inner::kSummaryOnly);
   std::optional<CalibrationResult> best;
   std::size_t best_row = 0;
   for (std::size_t k = 0; k < samples.size(); ++k) {
@@ -197,10 +218,16 @@ std::optional<CalibrationResult> consensus_start(const Robot& robot, const std::
       best_row = k;
     }
   }
-  if (!best) return std::nullopt;
+  if (!best) {
+    stage.finish(std::to_string(samples.size()) + " rows tried; none brings the rows with gross errors within the "
+                 "allowed fraction");
+    return std::nullopt;
+  }
   CalibrationResult candidate = *best;
   candidate.ok = false;
   const int id = samples[best_row].id;
+  stage.finish(std::to_string(samples.size()) + " rows tried; best leaves out row " + std::to_string(id) + " (" +
+               std::to_string(best->gross_errors.size()) + " gross errors beside it)");
   const double unknown = std::numeric_limits<double>::quiet_NaN();
   for (int i = 0; i < kCableCount; ++i) candidate.gross_errors.push_back({id, SensorKind::kEncoder, i, unknown});
   if (options.cable_model == CableModelKind::kCatenary) {
@@ -253,6 +280,9 @@ CalibrationResult swap_within_rows(const Robot& robot, const std::vector<Sample>
     const bool within = gross_error_row_fraction(searched, samples.size()) <= options.max_rejected_fraction;
     return within && !searched.misfit ? searched : result;
   }
+  StageScope stage("swap test: readings left out moved within row and cable", false,
+                   StageScope::Inner::kSummaryOnly);
+  int tried = 0, kept = 0;
   auto same = [](const SensorReading& a, const SensorReading& b) {
     return a.row == b.row && a.sensor == b.sensor && a.cable == b.cable;
   };
@@ -262,6 +292,7 @@ CalibrationResult swap_within_rows(const Robot& robot, const std::vector<Sample>
   };
   // Each change of the set left out: the fit, or nothing when it is not kept.
   auto try_change = [&](std::vector<SensorReading> changed, const SensorReading* in) -> std::optional<CalibrationResult> {
+    ++tried;
     CalibrationResult refit =
         calibrate_with_restart(started_at(robot, result), leave_out(samples, changed, options.cable_model), plain);
     if (!refit.ok) return std::nullopt;
@@ -316,7 +347,9 @@ CalibrationResult swap_within_rows(const Robot& robot, const std::vector<Sample>
     }
     if (!best) break;
     result = std::move(*best);
+    ++kept;
   }
+  stage.finish(std::to_string(tried) + " refits; " + std::to_string(kept) + " changes kept");
   return result;
 }
 
@@ -348,7 +381,7 @@ CalibrationResult calibrate_from(const Robot& robot, const std::vector<Sample>& 
   bool hypothesis = false;
   if (!result.ok && !result.gross_errors.empty() &&
       gross_error_row_fraction(result, samples.size()) > options.max_rejected_fraction) {
-    if (auto candidate = consensus_start(robot, samples, options)) {
+    if (auto candidate = consensus_start(robot, samples, options, true)) {
       result = std::move(*candidate);
       hypothesis = true;
     }
@@ -370,19 +403,26 @@ CalibrationResult calibrate_from(const Robot& robot, const std::vector<Sample>& 
   // solver/calibration/start_selection.h); a fit that misfits, by the one
   // with the smaller chi-square per degree of freedom (a genuine model
   // misfit stays flagged).
-  if (auto candidate = consensus_start(robot, samples, options)) {
-    CalibrationResult other = refit_without(robot, samples, options, *candidate);
-    if (other.ok) {
-      assess_model_fit(other, options);
-      auto per_dof = [](const CalibrationResult& r) {
-        return r.degrees_of_freedom > 0 ? r.chi_square / r.degrees_of_freedom
-                                        : std::numeric_limits<double>::infinity();
-      };
-      const bool take = result.misfit ? per_dof(other) < per_dof(result)
-                                      : !other.misfit && better_fit(other, result, options.rejection_threshold_sigma);
-      if (take) result = std::move(other);
-    }
+  if (samples.size() > kSmallSetRows) return result;
+  StageScope challenge("row hypotheses against the fit", false);
+  std::optional<CalibrationResult> candidate = consensus_start(robot, samples, options, false);
+  if (!candidate) {
+    challenge.finish("kept the fit: no hypothesis to challenge it");
+    return result;
   }
+  CalibrationResult other = refit_without(robot, samples, options, *candidate);
+  if (!other.ok) {
+    challenge.finish("kept the fit: the hypothesis' refit failed");
+    return result;
+  }
+  assess_model_fit(other, options);
+  auto per_dof = [](const CalibrationResult& r) {
+    return r.degrees_of_freedom > 0 ? r.chi_square / r.degrees_of_freedom : std::numeric_limits<double>::infinity();
+  };
+  const bool take = result.misfit ? per_dof(other) < per_dof(result)
+                                  : !other.misfit && better_fit(other, result, options.rejection_threshold_sigma);
+  challenge.finish(take ? "kept the hypothesis' fit: it explains the readings better" : "kept the fit");
+  if (take) result = std::move(other);
   return result;
 }
 
@@ -410,8 +450,13 @@ std::optional<Robot> rigid_start(const Robot& robot, const std::vector<Sample>& 
 CalibrationResult best_of_starts(const Robot& robot, const std::vector<Sample>& samples,
                                  const CalibrationOptions& options, CalibrationResult best) {
   const double threshold = options.rejection_threshold_sigma;
+  StageScope stage("other starts", true, StageScope::Inner::kSummaryOnly);
+  int tried = 0;
+  std::string kept = "the fit from the nominal anchors";
   auto consider = [&](CalibrationResult other, const char* why) {
+    ++tried;
     if (!better_fit(other, best, threshold)) return;
+    kept = why;
     other.message += std::string(" (kept from ") + why + ": it fits the readings better than the fit from the "
                      "nominal anchors)";
     best = std::move(other);
@@ -424,10 +469,11 @@ CalibrationResult best_of_starts(const Robot& robot, const std::vector<Sample>& 
   with_every_row(best, "a restart from the fit's own anchors, where every row could be started");
   if (const std::optional<Robot> start = rigid_start(robot, samples, options)) {
     CalibrationResult from_rigid = calibrate_from(*start, samples, options);
-    const CalibrationResult kept = from_rigid;
+    const CalibrationResult from_rigid_kept = from_rigid;
     consider(std::move(from_rigid), "a start at a rigid fit's anchors");
-    with_every_row(kept, "a start at a rigid fit's anchors, then its own");
+    with_every_row(from_rigid_kept, "a start at a rigid fit's anchors, then its own");
   }
+  stage.finish(std::to_string(tried) + " other starts fitted; kept " + kept);
   return best;
 }
 
@@ -448,9 +494,12 @@ CalibrationResult leave_out_hidden_errors(const Robot& robot, const std::vector<
   CalibrationOptions plain = options;
   plain.robust = false;
   const double threshold = options.rejection_threshold_sigma;
+  StageScope stage("hidden gross errors: readings a row's pose absorbed", false, StageScope::Inner::kSummaryOnly);
+  int tested = 0, left = 0;
   for (std::size_t round = 0; round < samples.size(); ++round) {
     bool changed = false;
     for (const SensorReading& hidden : hidden_gross_errors(robot, options, result, threshold)) {
+      ++tested;
       std::vector<SensorReading> out = result.gross_errors;
       out.push_back(hidden);
       CalibrationResult refit =
@@ -466,16 +515,20 @@ CalibrationResult leave_out_hidden_errors(const Robot& robot, const std::vector<
       if (refit.misfit || !better_fit(refit, result, threshold)) continue;
       result = std::move(refit);
       changed = true;
+      ++left;
       break;
     }
     if (!changed) break;
   }
+  stage.finish(std::to_string(tested) + " readings refitted without; " + std::to_string(left) + " left out");
   return result;
 }
 
 }  // namespace
 
 CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& samples, const CalibrationOptions& options) {
+  std::vector<CalibrationStage> stages;
+  const StageRecorder recorder(stages);
   CalibrationResult result = calibrate_from(robot, samples, options);
   if (options.robust && options.cable_model == CableModelKind::kCatenary && worth_other_starts(result)) {
     // The set the kept fit left out gets its swap test once, at the end.
@@ -488,13 +541,17 @@ CalibrationResult calibrate(const Robot& robot, const std::vector<Sample>& sampl
   test_missing_terms(robot, options, result);
   result.noise = noise_components(robot, options, result);
   if (result.refusal == Refusal::kSensorFault) {
+    StageScope stage("refusal cause: model terms and noise scales tried", false, StageScope::Inner::kSummaryOnly);
     classify_refusal(robot, samples, options, calibrate_from, result);
+    stage.finish(result.refusal == Refusal::kModelMisfit ? "the model: " + result.refusal_evidence
+                                                         : "the sensors: " + result.refusal_evidence);
     result.message = (result.refusal == Refusal::kModelMisfit ? "the model does not fit: " + result.refusal_evidence +
                                                                     " (not a sensor fault); "
                                                               : "the robot or its sensors need attention: " +
                                                                     result.refusal_evidence + "; ") +
                      result.message;
   }
+  result.stages = std::move(stages);
   return result;
 }
 

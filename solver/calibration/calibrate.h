@@ -141,6 +141,17 @@ enum class Refusal {
   kModelMisfit,  // as many rows, but a model term or a noise scale brings them within the limit
 };
 
+// One stage calibrate() ran (docs/calibration.md, "The stages of a
+// calibration"), in the order they ran.
+struct CalibrationStage {
+  std::string name;       // e.g. "robust fit, Huber", "restart from a rigid fit's anchors"
+  int depth = 0;          // 0: calibrate()'s own; n: inside the stage of depth n - 1 above it
+  bool fallback = false;  // run because the stage before it failed or left the fit in doubt
+  int iterations = 0;     // Levenberg-Marquardt iterations of its solves; 0 for a test
+  double cost = std::numeric_limits<double>::quiet_NaN();  // its solve's final cost; NaN for a test
+  std::string outcome;    // how it ended: the solver's stop, or what it decided and why
+};
+
 struct CalibrationResult {
   bool ok = false;
   std::string message;      // why it failed, or the solver's termination message
@@ -185,6 +196,11 @@ struct CalibrationResult {
   // AnchorKey(i), OffsetKey(i) per cable, then each effect's EffectKey.
   std::vector<Key> global_keys;
   Eigen::MatrixXd global_covariance;
+  // Every stage calibrate() ran on the way to this result, fallbacks and
+  // checks included; the fits inside a search (row hypotheses, other
+  // starts, swap test, hidden errors, refusal cause) are summed up in the
+  // search's own stage.
+  std::vector<CalibrationStage> stages;
 };
 
 // The factor graph of one calibration at its data-driven start, for

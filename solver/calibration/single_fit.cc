@@ -8,6 +8,7 @@
 #include <span>
 
 #include "solver/model/cable_prediction.h"
+#include "solver/calibration/calibration_stages.h"
 #include "solver/calibration/effect_pose_factor.h"
 #include "solver/nls/factor_parameters.h"
 #include "solver/calibration/gross_errors.h"
@@ -244,6 +245,8 @@ std::vector<SensorReading> robust_stages(BuiltProblem& built, LevenbergMarquardt
     *built.reading_loss = loss;
     lm.set_max_iterations(std::max(options.max_iterations - iterations, 0));
     const SolverSummary s = lm.solve();
+    record_stage(loss.kind == LossKind::kHuber ? "robust fit, Huber" : "robust fit, Cauchy", s.message, s.iterations,
+                 s.final_cost);
     if (iterations == 0) summary.initial_cost = s.initial_cost;
     iterations += s.iterations;
     summary.iterations = iterations;
@@ -259,7 +262,10 @@ std::vector<SensorReading> robust_stages(BuiltProblem& built, LevenbergMarquardt
   if (!stage({LossKind::kCauchy, kCauchyWidth})) return {};
   const std::vector<ReadingResidual> residuals = reading_residuals(built, lm, options, reference_cable);
   const std::vector<SensorReading> flagged = gross_errors(residuals, options.rejection_threshold_sigma);
-  if (flagged.empty()) return {};
+  if (flagged.empty()) {
+    record_stage("gross-error test", "no reading beyond the threshold at the Cauchy fit");
+    return {};
+  }
   // Leave-one-out names the reading of each flagged row (solver/calibration/row_attribution.h).
   const ReadingSpreads spreads = reading_spreads(residuals);
   const LossFunction kept = *built.reading_loss;
@@ -292,6 +298,9 @@ std::vector<SensorReading> robust_stages(BuiltProblem& built, LevenbergMarquardt
   *built.reading_loss = kept;
   std::sort(named.begin(), named.end(),
             [](const SensorReading& a, const SensorReading& b) { return std::abs(a.value) > std::abs(b.value); });
+  record_stage("gross-error test", std::to_string(flagged.size()) + " readings beyond the threshold on " +
+                                       std::to_string(rows.size()) + " rows; leave-one-out names " +
+                                       std::to_string(named.size()) + " of them");
   return named;
 }
 
@@ -304,7 +313,15 @@ CalibrationResult calibrate_once(const Robot& robot, const std::vector<Sample>& 
   result.rejected_samples = built.rejected_samples;
   if (!built.problem) {
     result.message = built.message;
+    record_stage("start", built.message);
     return result;
+  }
+  if (!built.rejected_samples.empty()) {
+    std::string ids;
+    for (int id : built.rejected_samples) ids += (ids.empty() ? "" : ", ") + std::to_string(id);
+    record_stage("start", std::to_string(built.rejected_samples.size()) + " of " +
+                              std::to_string(all_samples.size()) +
+                              " rows cannot be started from these anchors (ids " + ids + ")");
   }
   const std::vector<Sample>& samples = built.samples;
   Problem& problem = *built.problem;
@@ -342,12 +359,16 @@ CalibrationResult calibrate_once(const Robot& robot, const std::vector<Sample>& 
   // stage's, which is bit for bit the final loss's.
   const bool same = options.robust && same_linearization(built, lm, *built.reading_loss, final_loss, catenary);
   *built.reading_loss = final_loss;
+  const char* final_name = options.huber_width > 0.0 ? "final fit, Huber" : "final fit, least squares";
   if (same && robust_summary.termination == TerminationType::kConverged) {
     result.solver = robust_summary;
+    record_stage(final_name, "the robust fit's minimum: its loss was quadratic at every reading", 0,
+                 robust_summary.final_cost);
   } else {
     if (same) lm.reuse_last_linearization();
     lm.set_max_iterations(std::max(options.max_iterations - iterations, 0));
     result.solver = lm.solve();
+    record_stage(final_name, result.solver.message, result.solver.iterations, result.solver.final_cost);
     if (iterations > 0) result.solver.initial_cost = robust_summary.initial_cost;
     result.solver.iterations += iterations;
     result.solver.successful_steps += robust_summary.successful_steps;
