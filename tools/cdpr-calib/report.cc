@@ -15,6 +15,17 @@ void print_iteration(std::FILE* out, const IterationSummary& it) {
                it.step_accepted ? "accepted" : "rejected");
 }
 
+void print_stages(std::FILE* out, const std::vector<CalibrationStage>& stages) {
+  std::fprintf(out, "stages (docs/calibration.md, \"The stages of a calibration\"):\n");
+  for (const CalibrationStage& s : stages) {
+    const std::string name = std::string(2 * static_cast<std::size_t>(s.depth), ' ') + s.name +
+                             (s.fallback ? " [fallback]" : "");
+    char cost[32] = "";
+    if (std::isfinite(s.cost)) std::snprintf(cost, sizeof cost, "cost %.6e", s.cost);
+    std::fprintf(out, "  %-58s %5d it  %-17s  %s\n", name.c_str(), s.iterations, cost, s.outcome.c_str());
+  }
+}
+
 void print_summary(std::FILE* out, const CalibrationResult& result, const Robot& robot) {
   const SolverSummary& s = result.solver;
   std::fprintf(out, "\nsolver: %s\n", result.message.c_str());

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "solver/calibration/calibrate.h"
 
@@ -11,6 +12,9 @@ namespace cdpr::tools {
 
 void print_iteration(std::FILE* out, const IterationSummary& it);
 void print_summary(std::FILE* out, const CalibrationResult& result, const Robot& robot);
+// The stages calibrate() ran (CalibrationResult::stages), one line each,
+// nested stages indented under the one that ran them.
+void print_stages(std::FILE* out, const std::vector<CalibrationStage>& stages);
 // Fitted (or true) [effects] values, each with its "<name>_sigma" if present.
 void print_effects(std::FILE* out, const EffectValues& effects);
 // Anchor and offset errors against a simulator's truth.toml; [effects] keys

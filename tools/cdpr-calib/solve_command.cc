@@ -48,6 +48,7 @@ int refused(const SolveArgs& args, const CalibrationResult& result, const Robot&
   std::fprintf(stderr, "cdpr-calib: calibration refused: %s%s\n", result.message.c_str(),
                args.quiet ? " (all of them: run without -q)" : "");
   if (!args.quiet) print_summary(stdout, result, robot);
+  if (args.verbose) print_stages(stdout, result.stages);
   return model ? kExitRefusedModelMisfit : 2;
 }
 
@@ -84,6 +85,9 @@ void add_solve_command(CLI::App& app, SolveArgs& args) {
                   "exit 0 even when the model does not fit the data or the problem is under-determined (the "
                   "calibration.toml says so in model_warning either way)");
   solve->add_flag("-q,--quiet", args.quiet, "no per-iteration progress lines");
+  solve->add_flag("-v,--verbose", args.verbose,
+                  "also list the stages the calibration ran (robust fit, gross-error test, refits, restarts and "
+                  "other starts taken as fallbacks), each with its iterations, cost and outcome");
 }
 
 int run_solve(const SolveArgs& args) {
@@ -110,6 +114,7 @@ int run_solve(const SolveArgs& args) {
   CalibrationResult result = calibrate(*robot, *samples, options);
   if (!result.ok && result.refusal != Refusal::kNone) return refused(args, result, *robot);
   print_summary(stdout, result, *robot);
+  if (args.verbose) print_stages(stdout, result.stages);
   if (!result.ok) {
     std::fprintf(stderr, "cdpr-calib: calibration failed: %s\n", result.message.c_str());
     return 2;

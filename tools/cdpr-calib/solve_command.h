@@ -20,6 +20,7 @@ struct SolveArgs {
   double height_sigma_m = 1e-2;
   int max_iterations = CalibrationOptions{}.max_iterations;
   bool quiet = false;
+  bool verbose = false;  // -v: also the stages calibrate() ran
   bool accept_misfit = false;
   bool least_squares = false;  // --no-robust
   double max_rejected_fraction = CalibrationOptions{}.max_rejected_fraction;
