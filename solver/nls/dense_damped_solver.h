@@ -6,7 +6,8 @@
 // the rest pose at a commanded position (model/static_pose.cc) and the
 // leave-one-out refit of a row (calibration/row_attribution.cc).
 // LevenbergMarquardt (levenberg_marquardt.h) is its sparse sibling for whole
-// factor graphs; both damp and judge their steps the same way:
+// factor graphs; both damp and judge their steps the same way (its cost is
+// chi2 / 2, which leaves the gain ratio as it is):
 //
 //   chi2(x) = |r(x)|^2, r whitened by the caller
 //   (J^T J + D / radius) dx = -g,  g = J^T r,  D = diag(J^T J) clamped to
@@ -28,6 +29,8 @@
 //   the model predicts no more decrease than the bar (rounding would then
 //   refuse trial after trial), or an accepted step decreased chi2 by less
 //                                                kSmallGain
+// and when the callback cannot evaluate the start (kNotEvaluable), or central
+// differences next to an accepted point (kJacobianNotEvaluable).
 // x is the best point found: the start or the last accepted trial, each of
 // which the callback evaluated. Fixed sizes allocate nothing; with
 // Eigen::Dynamic the buffers are sized by the callback's first answer.
