@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "lm_test_factors.h"
+#include "solver/nls/dense_damped_solver.h"
 #include "solver/nls/levenberg_marquardt.h"
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -198,6 +199,35 @@ TEST(LevenbergMarquardtAllocation, IterationLoopWithASharedCauchyLossAllocatesNo
   if (!CDPR_COUNT_ALLOCATIONS) GTEST_SKIP() << "allocation counting is off under AddressSanitizer";
   const LossFunction cauchy{LossKind::kCauchy, 3.0};
   expect_loop_allocates_nothing(false, LinearSystemKind::kPosesEliminated, Loss{0.0, &cauchy});
+}
+
+TEST(DenseDampedSolverAllocation, FixedSizesAllocateNothing) {
+  // The small solves of one pose run per row and per start: with fixed
+  // sizes the whole solve, central differences and bounds included, stays
+  // off the heap.
+  if (!CDPR_COUNT_ALLOCATIONS) GTEST_SKIP() << "allocation counting is off under AddressSanitizer";
+  // GIVEN Rosenbrock by central differences, one coordinate bounded
+  DenseDampedOptions options;
+  options.gain_tolerance = 1e-14;
+  DenseDampedSolver<2, 2> solver(options);
+  solver.set_bounds(Eigen::Vector2d(-5.0, -5.0), Eigen::Vector2d(0.9, 5.0));
+  Eigen::Vector2d x(-1.2, 1.0);
+  int evaluations = 0;
+  auto rosenbrock = [&](const Eigen::Vector2d& at, Eigen::Vector2d& r) {
+    ++evaluations;
+    r << 10.0 * (at(1) - at(0) * at(0)), 1.0 - at(0);
+    return true;
+  };
+  // WHEN minimised with the counter on
+  g_allocations = 0;
+  g_counting = true;
+  const DenseDampedSummary summary = solver.minimize_numeric(x, rosenbrock);
+  g_counting = false;
+  // THEN it took many steps, ended on the bound, and allocated nothing
+  EXPECT_GT(summary.accepted, 5);
+  EXPECT_GT(evaluations, 20);
+  EXPECT_EQ(x(0), 0.9);
+  EXPECT_EQ(g_allocations.load(), 0);
 }
 
 }  // namespace
