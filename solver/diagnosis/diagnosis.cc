@@ -5,6 +5,7 @@
 #include <optional>
 #include <utility>
 
+#include "solver/calibration/gross_errors.h"
 #include "solver/calibration/noise_components.h"
 #include "solver/diagnosis/fit_comparison.h"
 #include "solver/diagnosis/held_out_comparison.h"
@@ -219,7 +220,8 @@ void record_mimics(Diagnosis& d, const Round& r, const std::vector<CandidateScor
   MimicSet set;
   set.step = d.steps.size();
   auto member = [&](const CandidateScore& c, const CalibrationResult* fit) {
-    MimicMember m{c.effect, c.noise, c.noise_scale, taken.aic_gain() - c.aic_gain(), {}};
+    MimicMember m{c.effect, c.noise, c.noise_scale, taken.aic_gain() - c.aic_gain(), {},
+                  fit ? fit->calibration : d.steps.back().fit.calibration};
     if (fit && !c.noise) {
       for (const std::string& name : effect_value_names(c.effect)) {
         for (const std::string& key : {name, name + "_sigma"}) {
@@ -386,6 +388,41 @@ namespace {
 
 Diagnosis diagnose_rows(const Robot& robot, const std::vector<Sample>& samples, const DiagnosisOptions& options);
 
+// Of the starting model's gross errors, those a robust fit of the terms
+// found (solver/calibration/calibrate.h) also finds. The judge is the final
+// model with every term of its mimic sets: of terms alike on the other
+// poses, the one that explains these readings may be the one the workflow
+// did not take. It fits every reading (a leave-one-out prediction of a row
+// that lost two readings is too loose to judge by).
+std::vector<SensorReading> still_gross_errors(const Robot& robot, const std::vector<Sample>& all_samples,
+                                              const std::vector<SensorReading>& gross_errors, const Diagnosis& d,
+                                              const CalibrationOptions& start) {
+  CalibrationOptions judge = start;
+  judge.effects = d.steps.back().model;
+  for (const MimicSet* set : standing_mimic_sets(d)) {
+    for (const MimicMember& m : set->members) {
+      if (!m.noise && std::find(judge.effects.begin(), judge.effects.end(), m.effect) == judge.effects.end()) {
+        judge.effects.push_back(m.effect);
+      }
+    }
+  }
+  // A term another one contains (load_cell_bias in load_cell) goes: they share a parameter.
+  std::erase_if(judge.effects, [&](Effect e) {
+    return std::any_of(judge.effects.begin(), judge.effects.end(),
+                       [&](Effect other) { return other != e && effect_contains(other, e); });
+  });
+  const CalibrationResult judged = calibrate(robot, all_samples, judge);
+  if (!judged.ok) return gross_errors;
+  std::vector<SensorReading> standing;
+  for (const SensorReading& r : gross_errors) {
+    const bool again = std::any_of(judged.gross_errors.begin(), judged.gross_errors.end(), [&](const SensorReading& g) {
+      return g.row == r.row && g.sensor == r.sensor && g.cable == r.cable;
+    });
+    if (again) standing.push_back(r);
+  }
+  return standing;
+}
+
 }  // namespace
 
 Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& all_samples, const DiagnosisOptions& options) {
@@ -403,10 +440,46 @@ Diagnosis diagnose(const Robot& robot, const std::vector<Sample>& all_samples, c
   // that noise floor.
   plain.fit.misfit_alpha = 0.0;
   Diagnosis d = diagnose_rows(robot, samples, plain);
-  d.gross_errors = robust.gross_errors;
-  d.final_fit.calibration.rejected = robust.gross_errors;
-  d.final_fit.gross_errors = robust.gross_errors;
+  std::vector<SensorReading> gross_errors = robust.gross_errors;
+  // The starting model judged the gross errors without the terms the
+  // workflow found. Where a term matters most (a load-cell gain at the
+  // highest tensions, the very poses that tell it from a bias) its missing
+  // signal looks like gross errors to that model: those the final model
+  // explains go back in, and the workflow runs once more on them.
+  if (d.ok && !gross_errors.empty() && !d.steps.back().model.empty()) {
+    const std::vector<SensorReading> standing = still_gross_errors(robot, all_samples, gross_errors, d, options.fit);
+    if (standing.size() < gross_errors.size()) {
+      report(options, std::to_string(gross_errors.size() - standing.size()) +
+                          " of them explained by the terms found: taken back, diagnosing again");
+      Diagnosis again = diagnose_rows(robot, leave_out(all_samples, standing, options.fit.cable_model), plain);
+      if (again.ok) {
+        d = std::move(again);
+        gross_errors = standing;
+      }
+    }
+  }
+  d.gross_errors = gross_errors;
+  d.final_fit.calibration.rejected = gross_errors;
+  d.final_fit.gross_errors = gross_errors;
   return d;
+}
+
+std::vector<const MimicSet*> standing_mimic_sets(const Diagnosis& d) {
+  std::vector<const MimicSet*> out;
+  if (d.steps.empty()) return out;
+  const std::vector<Effect>& model = d.steps.back().model;
+  for (const MimicSet& set : d.mimic_sets) {
+    const bool standing = std::any_of(set.members.begin(), set.members.end(), [&](const MimicMember& m) {
+      if (m.noise) {
+        return std::any_of(d.noise.begin(), d.noise.end(), [&](const NoiseFinding& f) { return f.group == *m.noise; });
+      }
+      return std::any_of(model.begin(), model.end(), [&](Effect e) {
+        return e == m.effect || effect_contains(e, m.effect) || effect_contains(m.effect, e);
+      });
+    });
+    if (standing) out.push_back(&set);
+  }
+  return out;
 }
 
 namespace {

@@ -100,6 +100,12 @@ struct MimicMember {
   double noise_scale = 1.0;
   double aic_gap = 0.0;   // Akaike gain of the term taken less this one's (>= 0)
   EffectValues values;    // its fitted [effects] values with their sigmas (terms)
+  // What this member says the robot is: its model's whole fit on all
+  // samples (anchors, offsets, effects); for a noise scale the fit of the
+  // model it would have scaled, whose predictions it leaves as they are.
+  // Where two members' predictions differ most is where a pose tells them
+  // apart (tools/cdpr-calib/discriminating_poses.h).
+  Calibration fit;
 };
 
 // Terms that explain the data about equally on these poses: the one a step
@@ -138,6 +144,10 @@ struct Diagnosis {
   // every fit after it is least squares on the same readings.
   std::vector<SensorReading> gross_errors;
 };
+
+// The mimic sets that still hold a term of the final model (or a noise
+// finding): a set whose member was later removed says nothing of the answer.
+std::vector<const MimicSet*> standing_mimic_sets(const Diagnosis& diagnosis);
 
 // With options.fit.robust (the default) the starting model is first fitted
 // robustly on all samples and its gross errors are left out (calibrate.h leave_out).

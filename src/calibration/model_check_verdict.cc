@@ -23,6 +23,29 @@ std::string values_text(const EffectValues& values, Effect effect) {
   return text;
 }
 
+// "; orientation noise 2.31x robot.toml; load_cell_bias or load_cell:
+// indistinguishable on these poses (...)": what else the check found, for
+// the end of the verdict. No piece has the "term: values" shape
+// model_check_terms() reads as a term.
+std::string findings_text(const Diagnosis& diagnosis) {
+  std::string text;
+  for (const NoiseFinding& f : diagnosis.noise) {
+    text += "; " + std::string(noise_group_description(f.group)) + " " + significant(f.scale, 3) + "x robot.toml";
+  }
+  for (const MimicSet* set : standing_mimic_sets(diagnosis)) {
+    std::string names;
+    for (std::size_t j = 0; j < set->members.size(); ++j) {
+      const MimicMember& m = set->members[j];
+      const std::string name = m.noise ? std::string(noise_group_description(*m.noise)) + " scale"
+                                       : std::string(effect_model_name(m.effect));
+      names += (j == 0 ? "" : j + 1 == set->members.size() ? " or " : ", ") + name;
+    }
+    text += "; " + names +
+            " indistinguishable on these poses (cdpr-calib diagnose proposes the waypoints that tell them apart)";
+  }
+  return text;
+}
+
 }  // namespace
 
 std::string model_check_verdict(const Diagnosis& diagnosis) {
@@ -34,14 +57,15 @@ std::string model_check_verdict(const Diagnosis& diagnosis) {
     effects += (effects.empty() ? "" : "; ") + std::string(effect_model_name(effect)) + ": " +
                values_text(diagnosis.final_fit.calibration.effects, effect);
   }
+  const std::string findings = findings_text(diagnosis);
   if (diagnosis.structure_remains) {
     const std::string remains =
         misfit + ", p = " + significant(diagnosis.structure_p_value, 2);
-    if (effects.empty()) return "structure remains that no known effect explains (" + remains + ")";
-    return effects + "; structure remains (" + remains + ")";
+    if (effects.empty()) return "structure remains that no known effect explains (" + remains + ")" + findings;
+    return effects + "; structure remains (" + remains + ")" + findings;
   }
-  if (effects.empty()) return "model explains the data (" + misfit + ")";
-  return effects + " (explains the data: " + misfit + ")";
+  if (effects.empty()) return "model explains the data (" + misfit + ")" + findings;
+  return effects + " (explains the data: " + misfit + ")" + findings;
 }
 
 std::vector<std::string> model_check_terms(std::string_view verdict) {

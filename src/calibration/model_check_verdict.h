@@ -8,6 +8,10 @@
 //   "structure remains that no known effect explains (held-out normalized rms 2.4, p = 1e-09)"
 //   "model check could not run: <why>"
 //
+// followed by what else it found: "; orientation noise 2.31x robot.toml"
+// per noise finding, "; load_cell_bias or load_cell indistinguishable on
+// these poses (...)" per mimic set that stands.
+//
 // Values in the [effects] names and units of docs/FORMATS.md. The verdict
 // only informs: the committed calibration keeps the daemon's model.
 

@@ -118,24 +118,41 @@ hal::Result<std::unique_ptr<ControlServer>> ControlServer::listen(const std::str
   }
   if (hal::Status removed = remove_stale_socket(path, address); !removed.ok()) return removed;
 
+  // Bound, given its group and mode and listening under a name of its own,
+  // then renamed into place: the socket appears at `path` ready, so a client
+  // (or a unit's ExecStartPost) that sees the file can connect at once. A
+  // path too long for the extra suffix is bound where it is.
+  const std::string staging = path + kStagingSuffix;
+  sockaddr_un bind_address = address;
+  const bool staged = staging.size() < sizeof(bind_address.sun_path);
+  if (staged) {
+    std::memcpy(bind_address.sun_path, staging.c_str(), staging.size() + 1);
+    struct stat leftover {};
+    if (lstat(staging.c_str(), &leftover) == 0 && S_ISSOCK(leftover.st_mode)) unlink(staging.c_str());
+  }
+  const std::string& bound_path = staged ? staging : path;
+
   const int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
   if (fd < 0) return errno_status(path, "socket");
-  if (bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) != 0) {
-    hal::Status status = errno_status(path, "bind");
+  if (bind(fd, reinterpret_cast<const sockaddr*>(&bind_address), sizeof(bind_address)) != 0) {
+    hal::Status status = errno_status(bound_path, "bind");
     close(fd);
     return status;
   }
   // Clients are the robot's operators (group of the socket); nobody else.
   // The group is right before the mode opens the socket to it. The backlog
   // holds a burst of simultaneous connects until the next service().
-  hal::Status status = wanted_gid ? give_socket_to_group(path, *wanted_gid, group) : hal::Status::Ok();
-  if (status.ok() && chmod(path.c_str(), static_cast<mode_t>(mode)) != 0) status = errno_status(path, "chmod");
-  if (status.ok() && ::listen(fd, static_cast<int>(kMaxClients)) != 0) status = errno_status(path, "listen");
+  hal::Status status = wanted_gid ? give_socket_to_group(bound_path, *wanted_gid, group) : hal::Status::Ok();
+  if (status.ok() && chmod(bound_path.c_str(), static_cast<mode_t>(mode)) != 0) {
+    status = errno_status(bound_path, "chmod");
+  }
+  if (status.ok() && ::listen(fd, static_cast<int>(kMaxClients)) != 0) status = errno_status(bound_path, "listen");
+  if (status.ok() && staged && rename(staging.c_str(), path.c_str()) != 0) status = errno_status(path, "rename");
   struct stat bound {};
   if (status.ok() && lstat(path.c_str(), &bound) != 0) status = errno_status(path, "lstat");
   if (!status.ok()) {
     close(fd);
-    unlink(path.c_str());
+    unlink(bound_path.c_str());
     return status;
   }
   return std::unique_ptr<ControlServer>(new ControlServer(fd, path, bound.st_dev, bound.st_ino, std::move(handler)));

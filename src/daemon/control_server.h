@@ -52,6 +52,8 @@ namespace cdpr::daemon {
 class ControlServer {
  public:
   static constexpr std::size_t kMaxClients = 128;
+  // The socket is bound under its path plus this, then renamed into place (listen()).
+  static constexpr const char* kStagingSuffix = ".binding";
   static constexpr std::size_t kMaxPendingOutputBytes = 1 << 20;
   // A client with this much of its answers unread gets no more requests
   // read until it has read them (backpressure): a pipelining client is

@@ -8,7 +8,9 @@
 #include "model_option.h"
 #include "input_files.h"
 #include "report.h"
+#include "sim/discriminating_poses.h"
 #include "src/formats/calibration_toml.h"
+#include "src/formats/waypoints_csv.h"
 
 namespace cdpr::tools {
 namespace {
@@ -19,6 +21,58 @@ bool write_text(const std::filesystem::path& path, const std::string& text) {
   file.close();
   if (!file) std::fprintf(stderr, "cdpr-calib: cannot write %s\n", path.c_str());
   return static_cast<bool>(file);
+}
+
+// The sigmas diagnose weighed the readings with at its end: robot.toml's,
+// scaled by its noise findings.
+NoiseSigmas final_noise(const Robot& robot, const Diagnosis& d) {
+  NoiseSigmas noise = robot.noise;
+  for (const NoiseFinding& f : d.noise) {
+    if (f.group == NoiseGroup::kEncoder) noise.encoder_m *= f.scale;
+    if (f.group == NoiseGroup::kLoadCell) noise.force_n *= f.scale;
+    if (f.group == NoiseGroup::kPosition) noise.position_m *= f.scale;
+    if (f.group == NoiseGroup::kOrientation) noise.orientation_rad *= f.scale;
+  }
+  return noise;
+}
+
+// For each standing mimic set, the waypoints that tell its members apart
+// (sim/discriminating_poses.h): their text for the report, and the
+// waypoints to write.
+std::string discrimination_text(const Robot& robot, const std::vector<Sample>& samples, const Diagnosis& d,
+                                const DiagnoseArgs& args, std::vector<formats::PlannedWaypoint>* waypoints) {
+  std::string text;
+  sim::DiscriminationOptions options;
+  options.count = args.discriminate;
+  if (args.workspace.size() == 6) {
+    options.workspace_min = Eigen::Vector3d(args.workspace[0], args.workspace[1], args.workspace[2]);
+    options.workspace_max = Eigen::Vector3d(args.workspace[3], args.workspace[4], args.workspace[5]);
+  }
+  for (const MimicSet* set : standing_mimic_sets(d)) {
+    std::string names;
+    for (const MimicMember& m : set->members) {
+      names += (names.empty() ? "" : " or ") + mimic_member_name(m);
+    }
+    const sim::DiscriminatingPoses poses = sim::discriminating_poses(robot, final_noise(robot, d), samples, *set, options);
+    if (poses.waypoints.empty()) {
+      text += "DISCRIMINATE: " + names + ": no waypoints (" + poses.message + ")\n";
+      continue;
+    }
+    char line[400];
+    std::snprintf(line, sizeof line,
+                  "DISCRIMINATE: %s: at the %zu poses measured their predictions differ by at most %.1f sigma; "
+                  "%zu waypoints where they differ by %.1f-%.1f sigma (of %d feasible candidates):\n",
+                  names.c_str(), samples.size(), poses.measured_separation_sigma, poses.waypoints.size(),
+                  poses.waypoints.back().separation_sigma, poses.waypoints.front().separation_sigma, poses.feasible);
+    text += line;
+    for (const formats::PlannedWaypoint& w : poses.waypoints) {
+      std::snprintf(line, sizeof line, "  x %.2f  y %.2f  z %.2f  separation %.1f sigma\n", w.position_world.x(),
+                    w.position_world.y(), w.position_world.z(), w.separation_sigma);
+      text += line;
+      waypoints->push_back(w);
+    }
+  }
+  return text;
 }
 
 }  // namespace
@@ -46,6 +100,14 @@ void add_diagnose_command(CLI::App& app, DiagnoseArgs& args) {
       ->check(CLI::Range(0, 7))->capture_default_str();
   cmd->add_option("--height-sigma", args.height_sigma_m, "sigma [m] of the catenary end-height consistency, Eq. (15)")
       ->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--discriminate", args.discriminate,
+                  "when terms mimic each other on these poses: this many extra waypoints where their predictions "
+                  "differ most, printed and written to waypoints.csv in the report directory (0: none)")
+      ->check(CLI::Range(0, 100))->capture_default_str();
+  cmd->add_option("--workspace", args.workspace,
+                  "box xmin,ymin,zmin,xmax,ymax,zmax [m] of the platform origin to choose those waypoints in "
+                  "(default: the box of the poses measured)")
+      ->delimiter(',')->expected(6);
 }
 
 int run_diagnose(const DiagnoseArgs& args) {
@@ -80,7 +142,12 @@ int run_diagnose(const DiagnoseArgs& args) {
   options.progress = [](const std::string& line) { std::fprintf(stderr, "diagnose: %s\n", line.c_str()); };
 
   const Diagnosis diagnosis = diagnose(*robot, *samples, options);
-  const std::string text = diagnosis_text(diagnosis, context);
+  std::string text = diagnosis_text(diagnosis, context);
+  std::vector<formats::PlannedWaypoint> waypoints;
+  if (diagnosis.ok && args.discriminate > 0 && !standing_mimic_sets(diagnosis).empty()) {
+    std::fprintf(stderr, "diagnose: choosing waypoints that tell the mimic set apart\n");
+    text += discrimination_text(*robot, *samples, diagnosis, args, &waypoints);
+  }
   std::fputs(text.c_str(), stdout);
   if (!diagnosis.ok) return 2;
 
@@ -95,6 +162,13 @@ int run_diagnose(const DiagnoseArgs& args) {
     return 1;
   }
   std::printf("wrote %s and %s\n", (dir / "report.txt").c_str(), (dir / "report.html").c_str());
+  if (!waypoints.empty()) {
+    const std::string comment = "waypoints that tell the mimicking terms apart (cdpr-calib diagnose " +
+                                args.samples_path + ")";
+    if (!write_text(dir / "waypoints.csv", formats::format_waypoints_csv(waypoints, comment))) return 1;
+    std::printf("wrote %s: measure these and diagnose again (cdpr-sim --extra-positions on simulated data)\n",
+                (dir / "waypoints.csv").c_str());
+  }
   if (diagnosis.final_fit.ok) {
     Calibration calibration = diagnosis.final_fit.calibration;
     calibration.robot = robot->name;

@@ -4,6 +4,7 @@
 // of the final model.
 
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -19,6 +20,8 @@ struct DiagnoseArgs {
   double alpha = 0.01;
   int max_added = 4;
   double height_sigma_m = 1e-2;
+  int discriminate = 8;  // waypoints that tell a mimic set apart; 0: none
+  std::vector<double> workspace;  // xmin,ymin,zmin,xmax,ymax,zmax of those waypoints; empty: the measured box
 };
 
 void add_diagnose_command(CLI::App& app, DiagnoseArgs& args);

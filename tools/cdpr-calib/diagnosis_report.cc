@@ -101,43 +101,20 @@ std::string candidate_name(const CandidateScore& c) {
   return std::string(noise_group_description(*c.noise)) + format_text(" x%.2f", c.noise_scale);
 }
 
-// A mimic member's name: the term's, or "orientation noise x2.31".
-std::string member_name(const MimicMember& m) {
-  if (!m.noise) return std::string(effect_model_name(m.effect));
-  return std::string(noise_group_description(*m.noise)) + format_text(" x%.2f", m.noise_scale);
-}
-
-// The mimic sets that still hold a term of the final model (or a noise
-// finding): a set whose member was later removed says nothing of the answer.
-std::vector<const MimicSet*> standing_mimic_sets(const Diagnosis& d) {
-  std::vector<const MimicSet*> out;
-  const std::vector<Effect>& model = d.steps.back().model;
-  for (const MimicSet& set : d.mimic_sets) {
-    const bool standing = std::any_of(set.members.begin(), set.members.end(), [&](const MimicMember& m) {
-      if (m.noise) return std::any_of(d.noise.begin(), d.noise.end(), [&](const NoiseFinding& f) { return f.group == *m.noise; });
-      return std::any_of(model.begin(), model.end(), [&](Effect e) {
-        return e == m.effect || effect_contains(e, m.effect) || effect_contains(m.effect, e);
-      });
-    });
-    if (standing) out.push_back(&set);
-  }
-  return out;
-}
-
 // "load_cell_bias or load_cell: indistinguishable on these poses (Akaike
 // gap 0.8); load_cell_bias: force_bias = 12.1 +- 1.3; load_cell: ...".
 std::string mimic_text(const MimicSet& set) {
   std::string names, gaps, values;
   for (std::size_t j = 0; j < set.members.size(); ++j) {
     const MimicMember& m = set.members[j];
-    names += (j == 0 ? "" : j + 1 == set.members.size() ? " or " : ", ") + member_name(m);
+    names += (j == 0 ? "" : j + 1 == set.members.size() ? " or " : ", ") + mimic_member_name(m);
     if (j > 0) gaps += (gaps.empty() ? "" : ", ") + format_text("%.1f", m.aic_gap);
     std::string v;
     for (const auto& [name, numbers] : m.values) {
       if (name.ends_with("_sigma")) continue;
       v += (v.empty() ? "" : ", ") + name + " = " + values_text(m.values, name);
     }
-    values += "; " + member_name(m) + (v.empty() ? "" : ": " + v);
+    values += "; " + mimic_member_name(m) + (v.empty() ? "" : ": " + v);
   }
   return names + ": indistinguishable on these poses (Akaike gap " + gaps + " from the first, within " +
          format_text("%.0f", kMimicAicMargin) + ")" + values;
@@ -459,6 +436,11 @@ std::string diagnosis_html(const Diagnosis& d, const ReportContext& c) {
   }
   html += report::details("Full text report", "<pre>" + report::html_escape(diagnosis_text(d, c)) + "</pre>");
   return html + report::page_end();
+}
+
+std::string mimic_member_name(const MimicMember& m) {
+  if (!m.noise) return std::string(effect_model_name(m.effect));
+  return std::string(noise_group_description(*m.noise)) + format_text(" x%.2f", m.noise_scale);
 }
 
 }  // namespace cdpr::tools

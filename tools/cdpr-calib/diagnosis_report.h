@@ -21,4 +21,7 @@ struct ReportContext {
 std::string diagnosis_text(const Diagnosis& diagnosis, const ReportContext& context);
 std::string diagnosis_html(const Diagnosis& diagnosis, const ReportContext& context);
 
+// A mimic member's name: the term's, or "orientation noise x2.31".
+std::string mimic_member_name(const MimicMember& member);
+
 }  // namespace cdpr::tools

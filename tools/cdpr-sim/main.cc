@@ -13,6 +13,7 @@
 #include "src/formats/calibration_toml.h"
 #include "src/formats/robot_toml.h"
 #include "src/formats/samples_csv.h"
+#include "src/formats/waypoints_csv.h"
 #include "version/version.h"
 
 namespace {
@@ -76,7 +77,7 @@ bool write_file(const std::filesystem::path& path, const std::string& text) {
 struct Args {
   std::string preset = "large";
   std::string out_dir;
-  std::string encoder_scale, encoder_drift, com_offset, wind, workspace;
+  std::string encoder_scale, encoder_drift, com_offset, wind, workspace, extra_positions;
   std::string encoder_outlier_range = "0.5,2", force_spike_range = "50,500";
   std::uint64_t seed = 1;
 };
@@ -126,6 +127,11 @@ int main(int argc, char** argv) {
   app.add_option("--workspace", args.workspace,
                  "waypoint box xmin,ymin,zmin,xmax,ymax,zmax [m] of the platform origin (default: the preset's, "
                  "which spans the paper's Table I ranges; a wider box makes the anchors better observable)");
+  app.add_option("--extra-positions", args.extra_positions,
+                 "waypoints.csv (docs/FORMATS.md): measure these positions too, after the --poses rows (same robot, "
+                 "same noise of the other rows), e.g. the waypoints cdpr-calib diagnose proposes to tell mimicking "
+                 "terms apart")
+      ->check(CLI::ExistingFile);
   app.add_option("--design", config.design_candidates,
                  "0: poses spread evenly over the box; N: the --poses most informative of N feasible candidates "
                  "(D-optimal on the nominal anchors, solver/calibration/pose_design.h)")
@@ -193,6 +199,15 @@ int main(int argc, char** argv) {
     }
     config.workspace_min = Eigen::Vector3d(values[0], values[1], values[2]);
     config.workspace_max = Eigen::Vector3d(values[3], values[4], values[5]);
+  }
+
+  if (!args.extra_positions.empty()) {
+    const auto waypoints = cdpr::formats::read_waypoints_csv(args.extra_positions);
+    if (!waypoints) {
+      std::fprintf(stderr, "cdpr-sim: %s\n", waypoints.error().message().c_str());
+      return 1;
+    }
+    for (const auto& w : *waypoints) config.extra_positions.push_back(w.position_world);
   }
 
   const auto data = cdpr::sim::simulate_dataset(config);

@@ -103,6 +103,18 @@ Expected<SimulatedDataset, std::string> simulate_dataset(const DatasetConfig& co
         measure(data.true_robot, f.state, config.noise_scale, noise, static_cast<int>(data.samples.size())));
     data.states.push_back(f.state);
   }
+  for (std::size_t k = 0; k < config.extra_positions.size(); ++k) {
+    const Eigen::Vector3d& position = config.extra_positions[k];
+    const EquilibriumResult state = solve_equilibrium(data.true_robot, position, 0.0, options);
+    if (!state || !taut_enough(*state, spec.min_tension_n)) {
+      return Unexpected{"extra position " + std::to_string(k + 1) + " (" + std::to_string(position.x()) + ", " +
+                        std::to_string(position.y()) + ", " + std::to_string(position.z()) +
+                        ") has no taut equilibrium: " + (state ? std::string("a cable below the tension floor") : state.error().message)};
+    }
+    Rng noise = Rng::stream(config.seed, kStreamExtraPoseNoise, static_cast<std::uint64_t>(k));
+    data.samples.push_back(measure(data.true_robot, *state, config.noise_scale, noise, static_cast<int>(data.samples.size())));
+    data.states.push_back(*state);
+  }
   // After the noise, so a seed's noise is the same with and without a drift.
   const std::array<double, kCableCount>& drift = data.true_robot.effects.encoder_drift_m;
   const double last = static_cast<double>(std::max<std::size_t>(1, data.samples.size() - 1));

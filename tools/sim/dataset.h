@@ -52,6 +52,12 @@ struct DatasetConfig {
   // of the rows with one encoder reading off by 0.5-2 m, a fraction with the
   // load cell off by 50-500 N (either sign); listed in truth.toml.
   GrossErrors gross_errors;
+  // Poses measured after the regular ones, at these positions of the
+  // platform origin (yaw 0, as a planner holds it): e.g. the waypoints that
+  // tell mimicking model terms apart (cdpr-calib diagnose). Each row draws
+  // its noise from its own stream, so the regular rows are the same with and
+  // without them. A position without a taut equilibrium is an error.
+  std::vector<Eigen::Vector3d> extra_positions;
   int segments = 2000;                // sim/cable_shooting.h
   int max_candidates_per_pose = 20;   // give up after this many candidates per wanted pose
 };

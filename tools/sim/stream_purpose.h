@@ -15,5 +15,7 @@ inline constexpr std::uint64_t kStreamWaypointYaw = 4;  // index: candidate
 inline constexpr std::uint64_t kStreamSensorNoise = 5;  // index: candidate
 inline constexpr std::uint64_t kStreamEncoderOutliers = 6;
 inline constexpr std::uint64_t kStreamForceSpikes = 7;
+// The rows measured at positions given after the regular ones (DatasetConfig::extra_positions).
+inline constexpr std::uint64_t kStreamExtraPoseNoise = 20;  // index: extra position
 
 }  // namespace cdpr::sim

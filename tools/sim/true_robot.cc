@@ -1,5 +1,6 @@
 #include "sim/true_robot.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace cdpr::sim {
@@ -34,6 +35,36 @@ Truth truth_of(const TrueRobot& robot) {
   }
   truth.effects = effect_values(robot.effects);
   return truth;
+}
+
+HiddenEffects hidden_effects_of(const EffectValues& values) {
+  HiddenEffects e;
+  auto value = [&](const char* name, std::size_t size) -> const std::vector<double>* {
+    const auto v = values.find(name);
+    return v != values.end() && v->second.size() == size ? &v->second : nullptr;
+  };
+  auto vector3 = [](const std::vector<double>& v) { return Eigen::Vector3d(v[0], v[1], v[2]); };
+  if (const auto* v = value("axial_stiffness", 1)) e.axial_stiffness_n = (*v)[0];
+  if (const auto* v = value("encoder_scale", kCableCount)) std::copy(v->begin(), v->end(), e.encoder_scale.begin());
+  if (const auto* v = value("encoder_drift", kCableCount)) std::copy(v->begin(), v->end(), e.encoder_drift_m.begin());
+  if (const auto* v = value("force_bias", 1)) e.force_bias_n = (*v)[0];
+  if (const auto* v = value("force_gain", 1)) e.force_gain = (*v)[0];
+  if (const auto* v = value("com_offset", 3)) e.com_offset_platform = vector3(*v);
+  if (const auto* v = value("density_error", 1)) e.density_error = (*v)[0];
+  if (const auto* v = value("pulley_radius", 1)) e.pulley_radius_m = (*v)[0];
+  if (const auto* v = value("wind_force", 3)) e.wind_force_world_n = vector3(*v);
+  return e;
+}
+
+TrueRobot robot_of(const Robot& nominal, const Calibration& calibration) {
+  TrueRobot robot;
+  robot.robot = nominal;
+  for (std::size_t i = 0; i < calibration.winches.size() && i < robot.robot.winches.size(); ++i) {
+    robot.robot.winches[i].anchor_world = calibration.winches[i].anchor_world;
+    robot.encoder_offset_m[i] = calibration.winches[i].offset_m;
+  }
+  robot.effects = hidden_effects_of(calibration.effects);
+  return robot;
 }
 
 }  // namespace cdpr::sim

@@ -63,4 +63,13 @@ EffectValues effect_values(const HiddenEffects& effects);
 // truth.toml content: true anchors, offsets and effects.
 Truth truth_of(const TrueRobot& robot);
 
+// The effects an [effects] table names (the inverse of effect_values; a
+// name it does not know, or a value of the wrong size, is left absent).
+HiddenEffects hidden_effects_of(const EffectValues& values);
+
+// The robot a fitted calibration says `nominal` is: its anchors, offsets
+// and effect values as the truth. Predicting readings with it (noiseless
+// sim/sensors.h measure) is what the fit expects at a pose it has not seen.
+TrueRobot robot_of(const Robot& nominal, const Calibration& calibration);
+
 }  // namespace cdpr::sim

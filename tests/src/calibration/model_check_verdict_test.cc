@@ -38,6 +38,25 @@ TEST(ModelCheckVerdict, SaysWhenStructureRemainsOrTheModelExplainsTheData) {
   EXPECT_EQ(model_check_verdict(failed), "model check could not run: too few samples");
 }
 
+TEST(ModelCheckVerdict, SaysWhichNoiseIsLargerThanStatedAndWhichTermsLookAlike) {
+  // GIVEN a check that took load_cell_bias, with load_cell about as good, and found the orientation noisier
+  Diagnosis d = finished({Effect::kLoadCellBias}, false);
+  d.final_fit.calibration.effects["force_bias"] = {20.5};
+  d.noise.push_back({NoiseGroup::kOrientation, 2.31});
+  MimicSet set;
+  set.members.resize(2);
+  set.members[0].effect = Effect::kLoadCellBias;
+  set.members[1].effect = Effect::kLoadCell;
+  d.mimic_sets.push_back(set);
+  // WHEN put in words
+  const std::string verdict = model_check_verdict(d);
+  // THEN both findings follow the term, and only the term reads back as one
+  EXPECT_NE(verdict.find("; orientation noise 2.31x robot.toml"), std::string::npos) << verdict;
+  EXPECT_NE(verdict.find("; load_cell_bias or load_cell indistinguishable on these poses"), std::string::npos)
+      << verdict;
+  EXPECT_EQ(model_check_terms(verdict), std::vector<std::string>{"load_cell_bias"}) << verdict;
+}
+
 TEST(ModelCheckVerdict, TheTermsItNamesAreReadBackFromItsText) {
   // GIVEN verdicts naming two effects (structure remaining), one, and none
   Diagnosis two = finished({Effect::kLoadCellBias, Effect::kElasticity}, true);

@@ -2,6 +2,7 @@
 // sockets: ordering, many concurrent clients, bounds, permissions, cleanup.
 
 #include <grp.h>
+#include <sys/inotify.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
@@ -81,6 +82,40 @@ std::string drain(int fd) {
     if (got <= 0) return text;
     text.append(buffer, static_cast<std::size_t>(got));
   }
+}
+
+TEST(ControlServer, TheSocketAppearsAtItsPathOnlyWhenItAcceptsConnections) {
+  // GIVEN a watch on the socket's directory
+  TempDir dir;
+  const std::string directory = std::filesystem::path(dir / "control").parent_path();
+  const int watch = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
+  ASSERT_GE(watch, 0);
+  ASSERT_GE(inotify_add_watch(watch, directory.c_str(), IN_CREATE | IN_MOVED_TO), 0);
+  // WHEN the server listens
+  StubHandler handler;
+  auto server = ControlServer::listen(dir / "control", std::ref(handler));
+  ASSERT_TRUE(server.ok()) << server.status().message();
+  // THEN "control" was never created in place (bound there, it would refuse
+  // connections until listen(): a client that saw the file too early got
+  // ECONNREFUSED); it was moved there, listening, and nothing else is left
+  std::vector<char> events(4096);
+  const ssize_t size = read(watch, events.data(), events.size());
+  close(watch);
+  ASSERT_GT(size, 0);
+  bool created_in_place = false, moved_in = false;
+  for (ssize_t at = 0; at < size;) {
+    const auto* event = reinterpret_cast<const inotify_event*>(events.data() + at);
+    const std::string name = event->len ? event->name : "";
+    if (name == "control" && (event->mask & IN_CREATE)) created_in_place = true;
+    if (name == "control" && (event->mask & IN_MOVED_TO)) moved_in = true;
+    at += static_cast<ssize_t>(sizeof(inotify_event) + event->len);
+  }
+  EXPECT_FALSE(created_in_place);
+  EXPECT_TRUE(moved_in);
+  EXPECT_FALSE(std::filesystem::exists(dir / (std::string("control") + ControlServer::kStagingSuffix)));
+  const int client = connect_to(dir / "control");
+  EXPECT_GE(client, 0);
+  if (client >= 0) close(client);
 }
 
 TEST(ControlServer, AnswersPipelinedRequestsInOrderOneLineEach) {
