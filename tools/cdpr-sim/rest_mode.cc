@@ -70,7 +70,10 @@ int run_rest_mode(const sim::DatasetConfig& config, const RestModeArgs& args, co
   if (!write(dir / "robot.toml", formats::format_robot_toml(sequence->nominal)) ||
       !write(dir / "samples.csv", formats::format_samples_csv(sequence->rests)) ||
       !write(dir / "true_poses.csv", formats::format_samples_csv(true_poses)) ||
-      !write(dir / "truth.toml", formats::format_truth_toml(sim::truth_of(sequence->true_robot)))) {
+      !write(dir / "truth.toml", formats::format_truth_toml(sim::truth_of(sequence->true_robot))) ||
+      !write(dir / "truth_after.toml",
+             formats::format_truth_toml(sim::truth_of(
+                 sim::robot_at_rest(*sequence, rc.fault, static_cast<int>(sequence->rests.size()) - 1))))) {
     return 1;
   }
   std::printf("wrote %s: %zu rests, fault %s", (dir / "samples.csv").c_str(), sequence->rests.size(),

@@ -25,8 +25,9 @@ struct RestModeArgs {
 void add_rest_mode_options(CLI::App& app, RestModeArgs& args);
 
 // Writes robot.toml, samples.csv (the rests, measured), true_poses.csv (the
-// same rows with the true poses in place of the measured ones) and
-// truth.toml (the robot before the fault) into `dir`, and prints the
+// same rows with the true poses in place of the measured ones),
+// truth.toml (the robot before the fault) and truth_after.toml (at the last
+// rest) into `dir`, and prints the
 // fault's truth. Exit code as cdpr-sim's.
 int run_rest_mode(const sim::DatasetConfig& config, const RestModeArgs& args, const std::filesystem::path& dir);
 
