@@ -15,11 +15,14 @@
 // likelihood ratio of a shift of the designed size theta_j against none:
 //   S+_j = max(0, S+_j + theta_j s_j - theta_j^2 I_j / 2),  S-_j the same for -theta_j.
 // Lorden: a CUSUM of log likelihood ratios crossing h has a mean run length
-// under no change of at least e^h, so with M = 2 x (number of terms)
-// statistics, h = ln(M N) keeps the whole test at no more than one false
-// alarm per N clean rests (Bonferroni; the terms of one cable are strongly
-// correlated, so the real rate is lower). A change of the designed size is
-// then flagged after about h / (theta_j^2 I_j / 2) rests.
+// under no change of at least e^h, so with M = 2 x 25 one-sided statistics,
+// h = ln(M N) keeps the whole test at no more than one false alarm per N
+// clean rests (default N = 1000, h = 10.8). Both steps are bounds: Siegmund's
+// approximation for Gaussian increments, ARL0 ~ e^(h + 1.166 delta) /
+// (delta^2 / 2) with delta = theta sqrt(I) (about 1.6 for a 2 cm slip on the
+// large robot: 5 times e^h), and the terms of one cable are strongly
+// correlated, so the real rate is several times lower. A change of the
+// designed size is flagged after about h / (theta_j^2 I_j / 2) rests.
 //
 // When a statistic crosses h the calibration is stale. The rests since the
 // crossing statistic last left zero (the change's onset) are refitted with
@@ -68,7 +71,7 @@ struct HealthWatchOptions {
   // Weight the onboard pose where a row has one (the strongest evidence).
   bool use_measured_pose = true;
   // Designed false-alarm rate: at most one per this many clean rests, the whole test.
-  double clean_rests_per_false_alarm = 1e4;
+  double clean_rests_per_false_alarm = 1e3;
   // Designed shifts (theta_j): the smallest changes worth flagging.
   double offset_shift_m = 0.02;
   double anchor_shift_m = 0.03;       // per world axis

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "solver/operation/calibration_covariance.h"
 #include "solver/operation/localize.h"
 #include "solver/operation/rest_problem.h"
 #include "src/formats/samples_csv.h"
@@ -52,6 +53,10 @@ void add_localize_command(CLI::App& app, LocalizeArgs& args) {
   cmd->add_option("--true-poses", args.true_poses_path,
                   "samples.csv whose poses are the truth (cdpr-sim --rests: true_poses.csv): print the errors")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--calibration-samples", args.calibration_samples_path,
+                  "the samples.csv the calibration was fitted on: the priors get the joint covariance of its "
+                  "anchors and offsets instead of their per-axis sigmas (honest sigmas; docs/operation.md)")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("--exact-calibration", args.exact_calibration,
                 "hold the calibration exact instead of as priors of its sigmas");
   cmd->add_option("--height-sigma", args.height_sigma_m, "sigma [m] of the catenary end-height consistency, Eq. (15)")
@@ -78,6 +83,20 @@ int run_localize(const LocalizeArgs& args) {
   LocalizeOptions options;
   options.calibration_priors = !args.exact_calibration;
   options.height_sigma_m = args.height_sigma_m;
+  if (!args.calibration_samples_path.empty()) {
+    auto samples = formats::read_samples_csv(args.calibration_samples_path, in->robot.cable_count());
+    if (!samples) {
+      std::fprintf(stderr, "cdpr-calib: %s\n", samples.error().message().c_str());
+      return 1;
+    }
+    std::string why;
+    options.calibration_covariance =
+        calibration_covariance(in->robot, in->calibration, *samples, args.height_sigma_m, &why);
+    if (!options.calibration_covariance) {
+      std::fprintf(stderr, "cdpr-calib: %s: %s\n", args.calibration_samples_path.c_str(), why.c_str());
+      return 1;
+    }
+  }
 
   std::ostringstream out;
   out << "# cdpr-calib localize (docs/operation.md): pose from the cables [m, rotation vector rad, world], its "

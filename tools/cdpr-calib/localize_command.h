@@ -17,6 +17,7 @@ struct LocalizeArgs {
   std::string output_path;       // CSV; empty = stdout
   std::string true_poses_path;   // optional: a samples.csv whose poses are the truth (cdpr-sim --rests)
   bool exact_calibration = false;  // the calibration held exact instead of as priors
+  std::string calibration_samples_path;  // the samples the calibration was fitted on: its joint covariance
   double height_sigma_m = 1e-2;
 };
 

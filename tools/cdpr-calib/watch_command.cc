@@ -156,6 +156,14 @@ int run_watch(const WatchArgs& args) {
                 request.offsets_only ? "the four offsets" : fault_term_name(request.term, request.cable).c_str(),
                 refit->samples);
     print_refit_changes(in->calibration, *refit);
+    double delta = 0.0;  // the largest change of a re-fitted value, signed
+    for (std::size_t i = 0; i < refit->winches.size(); ++i) {
+      const double offset = refit->winches[i].offset_m - in->calibration.winches[i].offset_m;
+      const double anchor = (refit->winches[i].anchor_world - in->calibration.winches[i].anchor_world).norm();
+      if (std::abs(offset) > std::abs(delta)) delta = offset;
+      if (anchor > std::abs(delta)) delta = anchor;
+    }
+    summary += format(" refit_delta_m=%.4f", delta, 0.0);
     if (!args.refit_path.empty()) {
       Calibration written = *refit;
       written.created = utc_timestamp_now();

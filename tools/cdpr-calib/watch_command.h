@@ -20,7 +20,7 @@ struct WatchArgs {
   bool offsets_only = false;
   bool verbose = false;
   bool no_measured_pose = false;
-  double clean_rests_per_false_alarm = 1e4;
+  double clean_rests_per_false_alarm = 1e3;
 };
 
 void add_watch_command(CLI::App& app, WatchArgs& args);
