@@ -23,7 +23,9 @@
 #   payload      +10 % platform mass, centre of mass 2 cm aside, from rest 10,
 #                30 rests: flagged and named load
 # An alarm before rest 10 in a fault run counts as a false alarm too.
-# LOCALIZE_OPTIONS adds options to cdpr-calib localize (e.g. --exact-calibration).
+# Both commands get the calibration's joint covariance from its samples
+# (--calibration-samples); LOCALIZE_OPTIONS replaces that for localize
+# (e.g. "--exact-calibration", or " " for the per-axis sigmas).
 set -euo pipefail
 build=${1:-build}
 seeds=${2:-10}
@@ -44,7 +46,8 @@ robot_options() {
 
 # watch DIR: the summary line of cdpr-calib watch on DIR's rests.
 watch() {
-  "$calib" watch "$1/robot.toml" "$dir/cal/calibration.toml" "$1/samples.csv" --truth "$1/truth_after.toml" |
+  "$calib" watch "$1/robot.toml" "$dir/cal/calibration.toml" "$1/samples.csv" --truth "$1/truth_after.toml" \
+    --calibration-samples "$dir/cal/samples.csv" |
     grep '^summary:' || true
 }
 
@@ -66,7 +69,8 @@ for preset in large small; do
     "$sim" $opts --seed "$seed" --rests "$clean_rests" --out "$dir/clean" >/dev/null
     # shellcheck disable=SC2086
     line=$("$calib" localize "$dir/clean/robot.toml" "$dir/cal/calibration.toml" "$dir/clean/samples.csv" \
-      --true-poses "$dir/clean/true_poses.csv" -o "$dir/clean/poses.csv" ${LOCALIZE_OPTIONS:-} 2>&1 |
+      --true-poses "$dir/clean/true_poses.csv" -o "$dir/clean/poses.csv" \
+      ${LOCALIZE_OPTIONS:---calibration-samples $dir/cal/samples.csv} 2>&1 |
       grep '^against' || true)
     rows=$(field rows "$line")
     if [[ -n $rows ]]; then

@@ -51,20 +51,53 @@ TermStatistic statistic_of_column(int j) {
   return s;
 }
 
-// The fit of one candidate over summed information: theta = A^-1 b.
-std::optional<TermEstimate> fit_candidate(const Candidate& c, const RestInformation& sum) {
-  const Eigen::MatrixXd A = sum.information.block(c.first_column, c.first_column, c.columns, c.columns);
-  const Eigen::VectorXd b = sum.score.segment(c.first_column, c.columns);
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(A);
-  if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || !(ldlt.vectorD().minCoeff() > 1e-12 * A.trace())) {
+constexpr int kBaseline = 16;  // the calibration's error: offsets (columns 0-3) and anchors (4-15)
+
+// The linearised fit over the calibration's error beta (in every rest) and
+// a candidate's change theta (after the onset): information H and score g
+// over x = (beta, theta), from the rests before (only beta) and since.
+struct Fit {
+  Eigen::MatrixXd H;
+  Eigen::VectorXd g;
+};
+
+Fit joint_fit(const Eigen::Matrix<double, kBaseline, kBaseline>& prior, const RestInformation& before,
+              const RestInformation& since, int first, int columns) {
+  Fit f;
+  const int n = kBaseline + columns;
+  f.H = Eigen::MatrixXd::Zero(n, n);
+  f.g = Eigen::VectorXd::Zero(n);
+  f.H.topLeftCorner(kBaseline, kBaseline) = prior + before.information.topLeftCorner<kBaseline, kBaseline>() +
+                                            since.information.topLeftCorner<kBaseline, kBaseline>();
+  f.g.head(kBaseline) = before.score.head<kBaseline>() + since.score.head<kBaseline>();
+  if (columns > 0) {
+    f.H.block(0, kBaseline, kBaseline, columns) = since.information.block(0, first, kBaseline, columns);
+    f.H.block(kBaseline, 0, columns, kBaseline) = since.information.block(first, 0, columns, kBaseline);
+    f.H.bottomRightCorner(columns, columns) = since.information.block(first, first, columns, columns);
+    f.g.tail(columns) = since.score.segment(first, columns);
+  }
+  return f;
+}
+
+// The fit of one candidate: theta and its covariance from H^-1 g, its
+// chi-square drop over the fit without it.
+std::optional<TermEstimate> fit_candidate(const Candidate& c, const Eigen::Matrix<double, kBaseline, kBaseline>& prior,
+                                          const RestInformation& before, const RestInformation& since) {
+  const Fit with = joint_fit(prior, before, since, c.first_column, c.columns);
+  const Fit without = joint_fit(prior, before, since, c.first_column, 0);
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(with.H), ldlt0(without.H);
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || !(ldlt.vectorD().minCoeff() > 1e-12 * with.H.trace()) ||
+      ldlt0.info() != Eigen::Success) {
     return std::nullopt;
   }
+  const Eigen::VectorXd x = ldlt.solve(with.g);
+  const Eigen::MatrixXd covariance = ldlt.solve(Eigen::MatrixXd::Identity(with.H.rows(), with.H.cols()));
   TermEstimate e;
   e.term = c.term;
   e.cable = c.cable;
-  e.value = ldlt.solve(b);
-  e.sigma = ldlt.solve(Eigen::MatrixXd::Identity(c.columns, c.columns)).diagonal().cwiseSqrt();
-  e.chi_square_drop = b.dot(e.value);
+  e.value = x.tail(c.columns);
+  e.sigma = covariance.bottomRightCorner(c.columns, c.columns).diagonal().cwiseSqrt();
+  e.chi_square_drop = with.g.dot(x) - without.g.dot(ldlt0.solve(without.g));
   return e;
 }
 
@@ -118,8 +151,32 @@ HealthWatch::HealthWatch(Robot robot, Calibration calibration, HealthWatchOption
         break;
     }
   }
-  // Lorden: ARL0 >= e^h per one-sided CUSUM; Bonferroni over all of them.
-  threshold_ = std::log(2.0 * kFaultColumns * options_.clean_rests_per_false_alarm);
+  // The calibration's error as a prior, in column order (offsets, then anchors).
+  baseline_information_.setZero();
+  if (options_.calibration_covariance) {
+    Eigen::Matrix<double, kBaseline, kBaseline> permute = Eigen::Matrix<double, kBaseline, kBaseline>::Zero();
+    for (int i = 0; i < kCableCount; ++i) {
+      permute(i, 12 + i) = 1.0;  // offset i: covariance row 12 + i
+      for (int a = 0; a < 3; ++a) permute(4 + 3 * i + a, 3 * i + a) = 1.0;
+    }
+    const Eigen::Matrix<double, kBaseline, kBaseline> covariance =
+        permute * *options_.calibration_covariance * permute.transpose();
+    baseline_information_ = covariance.inverse();
+  } else if (static_cast<int>(calibration_.winches.size()) == kCableCount) {
+    // A sigma of zero (unknown) counts as a tenth of a millimetre: held, not free.
+    const auto information = [](double sigma) { return 1.0 / std::max(sigma * sigma, 1e-8); };
+    for (int i = 0; i < kCableCount; ++i) {
+      const WinchCalibration& w = calibration_.winches[i];
+      baseline_information_(i, i) = information(w.offset_sigma_m);
+      for (int a = 0; a < 3; ++a) baseline_information_(4 + 3 * i + a, 4 + 3 * i + a) = information(w.anchor_sigma(a));
+    }
+  }
+  // Siegmund: a one-sided CUSUM of Gaussian log likelihood ratios with
+  // standardised shift delta crosses h, without change, after about
+  // e^(h + 1.166 delta) / (delta^2 / 2) rests; Bonferroni over all of them.
+  const double delta = options_.design_standardised_shift;
+  const double statistics = 2.0 * kFaultColumns;
+  threshold_ = std::log(statistics * options_.clean_rests_per_false_alarm * delta * delta / 2.0) - 1.166 * delta;
 }
 
 std::vector<Sample> HealthWatch::rests_since_onset() const {
@@ -236,27 +293,30 @@ void HealthWatch::update_statistics(const RestInformation& info, RestCheck& out)
 
 void HealthWatch::attribute() {
   StaleFinding& f = *finding_;
-  RestInformation sum;
+  RestInformation before, since;
   f.rests_fitted = 0;
   for (const RestInformation& info : information_) {
-    if (info.rest < f.since_rest) continue;
+    RestInformation& sum = info.rest < f.since_rest ? before : since;
     sum.score += info.score;
     sum.information += info.information;
-    ++f.rests_fitted;
+    if (info.rest >= f.since_rest) ++f.rests_fitted;
   }
   f.candidates.clear();
   for (const Candidate& c : candidates()) {
-    if (std::optional<TermEstimate> e = fit_candidate(c, sum)) f.candidates.push_back(*e);
+    if (std::optional<TermEstimate> e = fit_candidate(c, baseline_information_, before, since)) {
+      f.candidates.push_back(*e);
+    }
   }
   std::sort(f.candidates.begin(), f.candidates.end(),
             [](const TermEstimate& a, const TermEstimate& b) { return a.aic_gain() > b.aic_gain(); });
   f.alike.clear();
   if (f.candidates.empty()) return;
   f.term = f.candidates.front();
-  // An elongation differs from an offset of the same cable only through how
-  // the payout varies over the rests: it is named only when it explains
-  // them better by the margin; otherwise the slip, the commoner fault.
-  if (f.term.term == FaultTerm::kCableElongation) {
+  // An elongation or an anchor move differs from an offset of the same
+  // cable only through how the payout and the cable's direction vary over
+  // the rests: either is named only when it explains them better by the
+  // margin; otherwise the slip, the simpler and commoner fault.
+  if (f.term.term == FaultTerm::kCableElongation || f.term.term == FaultTerm::kAnchor) {
     for (const TermEstimate& e : f.candidates) {
       if (e.term == FaultTerm::kEncoderOffset && e.cable == f.term.cable &&
           f.term.aic_gain() - e.aic_gain() <= kAlikeAicMargin) {

@@ -14,25 +14,30 @@
 // Sequential change test: a two-sided CUSUM per term (Page), on the log
 // likelihood ratio of a shift of the designed size theta_j against none:
 //   S+_j = max(0, S+_j + theta_j s_j - theta_j^2 I_j / 2),  S-_j the same for -theta_j.
-// Lorden: a CUSUM of log likelihood ratios crossing h has a mean run length
-// under no change of at least e^h, so with M = 2 x 25 one-sided statistics,
-// h = ln(M N) keeps the whole test at no more than one false alarm per N
-// clean rests (default N = 1000, h = 10.8). Both steps are bounds: Siegmund's
-// approximation for Gaussian increments, ARL0 ~ e^(h + 1.166 delta) /
-// (delta^2 / 2) with delta = theta sqrt(I) (about 1.6 for a 2 cm slip on the
-// large robot: 5 times e^h), and the terms of one cable are strongly
-// correlated, so the real rate is several times lower. A change of the
-// designed size is flagged after about h / (theta_j^2 I_j / 2) rests.
+// Threshold: for Gaussian increments Siegmund's approximation gives the
+// mean run length of one side without change, ARL0 ~ e^(h + 1.166 delta) /
+// (delta^2 / 2), delta = theta sqrt(I) the standardised shift (designed 1.5:
+// a 2 cm slip seen through 10 mm encoders and the onboard pose). With
+// M = 2 x 25 one-sided statistics, h = ln(M N delta^2 / 2) - 1.166 delta keeps
+// the whole test at one false alarm per N clean rests (Bonferroni; default
+// N = 1000: h = 9.19). Lorden's bound ARL0 >= e^h guarantees at least one
+// per e^h / M = 196 rests whatever the increments; the terms of one cable are
+// strongly correlated, so the real rate is lower than designed. A change of
+// the designed size is flagged after about h / (theta_j^2 I_j / 2) rests.
 //
 // When a statistic crosses h the calibration is stale. The rests since the
 // crossing statistic last left zero (the change's onset) are refitted with
-// each candidate term (linearised, the per-rest pose and force eliminated):
-// the chi-square drop against its parameter count by Akaike's criterion, as
+// each candidate term (linearised, the per-rest pose and force eliminated),
+// the committed calibration's own error marginalised: its anchors and
+// offsets may be off within their covariance, by the same amount before and
+// after the onset, so the rests before it tell that error from the change.
+// The chi-square drop against its parameter count by Akaike's criterion, as
 // diagnose ranks terms (solver/diagnosis/diagnosis.h); the best names the
 // finding, with its size and sigma; candidates within 4 (diagnose's
 // kMimicAicMargin) of the best look alike and are listed. An elongation of a
-// cable is named over that cable's offset slip only when it beats it by
-// that margin: the two differ only by how the payout varies over the rests. The finding is re-estimated
+// cable or a move of its anchor is named over that cable's offset slip only
+// when it beats it by that margin: they differ only by how the payout and
+// the cable's direction vary over the rests. The finding is re-estimated
 // with every further rest.
 //
 // Term catalogue (the names of diagnose and of the calibration's keys):
@@ -72,6 +77,8 @@ struct HealthWatchOptions {
   bool use_measured_pose = true;
   // Designed false-alarm rate: at most one per this many clean rests, the whole test.
   double clean_rests_per_false_alarm = 1e3;
+  // The standardised shift delta = theta sqrt(I) the threshold is designed for.
+  double design_standardised_shift = 1.5;
   // Designed shifts (theta_j): the smallest changes worth flagging.
   double offset_shift_m = 0.02;
   double anchor_shift_m = 0.03;       // per world axis
@@ -79,6 +86,9 @@ struct HealthWatchOptions {
   double mass_shift_fraction = 0.05;  // of the platform mass
   double com_shift_m = 0.02;
   double force_bias_shift_n = 0.0;    // 0: 3 x the load cell's sigma
+  // The calibration's joint covariance of anchors and offsets
+  // (calibration_covariance.h); without it, its per-axis sigmas.
+  std::optional<Eigen::Matrix<double, 4 * kCableCount, 4 * kCableCount>> calibration_covariance;
 };
 
 // One scalar statistic of the sequential test.
@@ -175,6 +185,7 @@ class HealthWatch {
   std::vector<RestInformation> information_;
   std::vector<TermStatistic> statistics_;
   std::vector<double> shifts_;  // theta_j per statistic
+  Eigen::Matrix<double, 16, 16> baseline_information_;  // the calibration's error: inverse covariance, column order
   std::array<int, kFaultColumns> onset_up_{}, onset_down_{};  // where each side last left zero
   double threshold_ = 0.0;
   double reference_payout_m_ = 0.0;

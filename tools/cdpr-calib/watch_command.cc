@@ -5,9 +5,11 @@
 #include <fstream>
 
 #include "report.h"
+#include "solver/operation/calibration_covariance.h"
 #include "solver/operation/health_watch.h"
 #include "solver/operation/refit.h"
 #include "src/formats/calibration_toml.h"
+#include "src/formats/samples_csv.h"
 
 namespace cdpr::tools {
 namespace {
@@ -76,6 +78,10 @@ void add_watch_command(CLI::App& app, WatchArgs& args) {
       "re-fit it offers");
   add_operation_inputs(*cmd, args.inputs);
   cmd->add_option("--refit-output", args.refit_path, "write the offered re-fit (calibration.toml) here");
+  cmd->add_option("--calibration-samples", args.calibration_samples_path,
+                  "the samples.csv the calibration was fitted on: its anchors' and offsets' joint covariance, "
+                  "which tells the calibration's own error from a change (else its per-axis sigmas)")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("--offsets-only", args.offsets_only, "re-fit all four encoder offsets instead of the named term");
   cmd->add_option("--truth", args.truth_path,
                   "truth.toml of the robot after the change (cdpr-sim --rests: truth_after.toml): print the "
@@ -94,6 +100,20 @@ int run_watch(const WatchArgs& args) {
   HealthWatchOptions options;
   options.clean_rests_per_false_alarm = args.clean_rests_per_false_alarm;
   options.use_measured_pose = !args.no_measured_pose;
+  if (!args.calibration_samples_path.empty()) {
+    auto samples = formats::read_samples_csv(args.calibration_samples_path, in->robot.cable_count());
+    if (!samples) {
+      std::fprintf(stderr, "cdpr-calib: %s\n", samples.error().message().c_str());
+      return 1;
+    }
+    std::string why;
+    options.calibration_covariance =
+        calibration_covariance(in->robot, in->calibration, *samples, options.height_sigma_m, &why);
+    if (!options.calibration_covariance) {
+      std::fprintf(stderr, "cdpr-calib: %s: %s\n", args.calibration_samples_path.c_str(), why.c_str());
+      return 1;
+    }
+  }
   HealthWatch watch(in->robot, in->calibration, options);
   std::printf("health watch: %zu rests, threshold h = %.2f (at most one false alarm per %g clean rests)\n",
               in->rests.size(), watch.threshold(), args.clean_rests_per_false_alarm);

@@ -17,6 +17,7 @@ struct WatchArgs {
   OperationPaths inputs;
   std::string refit_path;   // write the offered re-fit's calibration.toml here (empty: do not)
   std::string truth_path;   // truth.toml of the robot after the change (cdpr-sim --rests: truth_after.toml)
+  std::string calibration_samples_path;  // the samples the calibration was fitted on: its joint covariance
   bool offsets_only = false;
   bool verbose = false;
   bool no_measured_pose = false;

@@ -31,7 +31,9 @@ TEST(HealthWatch, CleanRestsRaiseNoAlarm) {
   // THEN the watch stays quiet
   EXPECT_EQ(fired, -1);
   EXPECT_FALSE(watch.stale());
-  EXPECT_GT(watch.threshold(), 10.0);
+  // AND its threshold is the designed one: one false alarm per 1000 clean
+  // rests over 50 one-sided CUSUMs by Siegmund's approximation at delta 1.5
+  EXPECT_NEAR(watch.threshold(), std::log(50.0 * 1000.0 * 1.5 * 1.5 / 2.0) - 1.166 * 1.5, 1e-9);
 }
 
 TEST(HealthWatch, AnEncoderSlipIsFlaggedSoonAndNamesItsCable) {
