@@ -20,13 +20,18 @@ RestSequence rests_with(InjectedFault fault, int count) {
   return *sequence;
 }
 
+InjectedFault fault(FaultKind kind, int cable, double size, int from_rest) {
+  InjectedFault f;
+  f.kind = kind;
+  f.cable = cable;
+  f.size = size;
+  f.from_rest = from_rest;
+  return f;
+}
+
 TEST(SimRestSequence, AnEncoderSlipChangesThatEncoderAloneFromItsRestOn) {
   // GIVEN the same robot and rests with and without a 2 cm slip of cable 1 from rest 3
-  InjectedFault slip;
-  slip.kind = FaultKind::kEncoderSlip;
-  slip.cable = 1;
-  slip.size = 0.02;
-  slip.from_rest = 3;
+  const InjectedFault slip = fault(FaultKind::kEncoderSlip, 1, 0.02, 3);
   const RestSequence clean = rests_with({}, 6), slipped = rests_with(slip, 6);
   // THEN the rests lie at the same poses and only encoder 1 reads 2 cm more, from rest 3 on
   for (int k = 0; k < 6; ++k) {
@@ -39,21 +44,14 @@ TEST(SimRestSequence, AnEncoderSlipChangesThatEncoderAloneFromItsRestOn) {
 }
 
 TEST(SimRestSequence, AMovedAnchorAndAPayloadChangeTheTrueRobotFromTheirRest) {
-  InjectedFault anchor;
-  anchor.kind = FaultKind::kAnchorMoved;
-  anchor.cable = 2;
-  anchor.size = 0.05;
-  anchor.from_rest = 2;
+  const InjectedFault anchor = fault(FaultKind::kAnchorMoved, 2, 0.05, 2);
   const RestSequence moved = rests_with(anchor, 3);
   EXPECT_NEAR(moved.anchor_shift_world.norm(), 0.05, 1e-12);
   const TrueRobot before = robot_at_rest(moved, anchor, 1), after = robot_at_rest(moved, anchor, 2);
   EXPECT_TRUE((after.robot.winches[2].anchor_world - before.robot.winches[2].anchor_world)
                   .isApprox(moved.anchor_shift_world));
 
-  InjectedFault payload;
-  payload.kind = FaultKind::kPayloadChange;
-  payload.size = 0.4;
-  payload.from_rest = 1;
+  const InjectedFault payload = fault(FaultKind::kPayloadChange, 0, 0.4, 1);
   const TrueRobot heavier = robot_at_rest(moved, payload, 1);
   EXPECT_NEAR(heavier.robot.platform_mass_kg - moved.true_robot.robot.platform_mass_kg, 0.4, 1e-12);
 }
