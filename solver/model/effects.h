@@ -14,6 +14,12 @@
 // tensions of a calibration b and g are nearly collinear, so fitting both
 // leaves b with a sigma near its own size; a load cell whose gain is right is
 // named and measured far better by b alone. A model holds at most one of the two.
+// And pose_reference_offset d: the localization reports the position of a
+// point d [m, platform frame] off the platform origin, p_measured = p + R d.
+// With the term the fitted pose (PoseKey) is that reference point's, so the
+// pose prior is unchanged, and the platform origin the statics act on is
+// p - R d (solver/calibration/effect_pose_factor.cc). Only the part of R d
+// that changes with the orientation tells d from a shift of every anchor.
 //
 // Adding a term: an enumerator, its row (in enumerator order; a
 // static_assert checks), then its physics (docs/DESIGN.md "A new model term").
@@ -37,6 +43,7 @@ enum class Effect : int {
   kDensityError,
   kPulleyRadius,
   kLoadCellBias,
+  kPoseReferenceOffset,
 };
 
 // Compliance unit of the elasticity parameter: kappa [1/MN] = 1e6 / EA [N].
@@ -117,6 +124,11 @@ inline constexpr std::array kEffectCatalogue = {
                      "load-cell bias alone (gain right): reading = tension + b",
                      "the same with g = 0 (a model has at most one of the two)",
                      {EffectValueSpec{"force_bias", 1, "N"}}, 1, nullptr, {}, "within a few % of the range"},
+    EffectDescriptor{Effect::kPoseReferenceOffset, "pose_reference_offset", 3,
+                     "the localization's reference point d (3) [m, platform frame]",
+                     "pose reference offset: the localization measures the point d off the platform origin",
+                     "measured position = platform origin + R * d", {EffectValueSpec{"pose_reference_offset", 3, "m"}},
+                     1, nullptr, {}, "within the platform's size"},
 };
 
 inline constexpr int kEffectCount = static_cast<int>(kEffectCatalogue.size());

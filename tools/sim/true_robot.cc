@@ -23,6 +23,9 @@ EffectValues effect_values(const HiddenEffects& e) {
   if (!e.com_offset_platform.isZero(0.0)) values["com_offset"] = values_of(e.com_offset_platform);
   if (e.density_error != 0.0) values["density_error"] = {e.density_error};
   if (e.pulley_radius_m != 0.0) values["pulley_radius"] = {e.pulley_radius_m};
+  if (!e.pose_reference_offset_platform.isZero(0.0)) {
+    values["pose_reference_offset"] = values_of(e.pose_reference_offset_platform);
+  }
   if (!e.wind_force_world_n.isZero(0.0)) values["wind_force"] = values_of(e.wind_force_world_n);
   return values;
 }
