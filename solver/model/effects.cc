@@ -1,6 +1,7 @@
 #include "solver/model/effects.h"
 
 #include <cmath>
+#include <cstdio>
 
 namespace cdpr {
 
@@ -67,6 +68,16 @@ std::string effect_domain_violation(Effect e, const std::vector<double>& value, 
       return value.at(j) < -3.0 * sigma.at(j) ? std::string(domain.what) + " below zero by more than 3 sigma" : "";
     case EffectDomainRule::kPositiveFactor:
       return value.at(j) <= -1.0 ? std::string(domain.what) + " not positive" : "";
+    case EffectDomainRule::kComponentsWithin:
+      for (std::size_t k = 0; k < value.size(); ++k) {
+        if (std::abs(value[k]) - 3.0 * sigma.at(k) > domain.limit) {
+          char limit[32];
+          std::snprintf(limit, sizeof limit, "%g", domain.limit);
+          const std::string_view unit = effect_descriptor(e).values[0].unit;
+          return std::string(domain.what) + " beyond " + limit + " " + std::string(unit) + " by more than 3 sigma";
+        }
+      }
+      return {};
   }
   return {};
 }

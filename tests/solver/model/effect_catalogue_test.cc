@@ -81,6 +81,17 @@ TEST(EffectCatalogue, TheDocsTermTablesListTheCatalogue) {
   expect_generated("DESIGN.md", design_table());
 }
 
+TEST(EffectCatalogue, APoseReferencePointOffThePlatformIsOutsideItsDomain) {
+  // GIVEN fitted pose reference offsets with their sigmas
+  const std::vector<double> sigma{0.2, 0.2, 0.03};
+  // WHEN one lies on a 1 m platform, or beyond 0.5 m only within 3 sigma THEN it is plausible
+  EXPECT_EQ(effect_domain_violation(Effect::kPoseReferenceOffset, {0.3, -0.1, 0.4}, sigma), "");
+  EXPECT_EQ(effect_domain_violation(Effect::kPoseReferenceOffset, {1.0, 0.0, 0.2}, sigma), "");
+  // AND a component 1.05 +- 0.03 m off is not: the term is mimicking something else
+  EXPECT_EQ(effect_domain_violation(Effect::kPoseReferenceOffset, {0.6, 0.4, 1.05}, sigma),
+            "pose reference point beyond 0.5 m by more than 3 sigma");
+}
+
 TEST(EffectCatalogue, NamesAreUniqueAndEveryListFollowsTheRows) {
   // GIVEN the catalogue
   std::set<std::string_view> names;
