@@ -135,11 +135,14 @@ bench: bench-deps configure
 	$(BUILD)/tools/cdpr-bench
 
 # The generated docs, rewritten from the code that owns them: the key
-# listing of docs/configuration.md from the key tables (a unit test holds the
-# page to the tables and says when to run this).
+# listing of docs/configuration.md from the key tables, the model-term tables
+# of docs/diagnosis.md and docs/DESIGN.md from solver/model/effects.h (unit
+# tests hold the pages to them and say when to run this).
 docs: configure
 	cmake --build $(BUILD) -j $(JOBS) --target daemon_tests
 	CDPR_UPDATE_DOCS=1 $(BUILD)/tests/daemon_tests --gtest_filter='ConfigTable.TheDocsPage*'
+	cmake --build $(BUILD) -j $(JOBS) --target solver_model_tests
+	CDPR_UPDATE_DOCS=1 $(BUILD)/tests/solver_model_tests --gtest_filter='EffectCatalogue.TheDocs*'
 
 # The unit installed with the daemon names it under $(PREFIX) (systemd/CMakeLists.txt).
 install: all

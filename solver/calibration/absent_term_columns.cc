@@ -41,6 +41,7 @@ bool absent_term_jacobians(const Robot& robot, const BaseFitRow& row, double hei
   }
   auto at = [&](Effect e) { return block[static_cast<int>(e)]; };
 
+  const Eigen::Matrix3d world_R_platform = row.world_T_platform.world_R_platform.toRotationMatrix();
   const SampleSigmas sigma = reading_sigmas(robot, row.sample);
   const double sigma_height = row_height_sigma(robot, row.sample, height_sigma_m);
   const double w = robot.gravity_mps2 * robot.cable_linear_density_kgpm;
@@ -79,16 +80,33 @@ bool absent_term_jacobians(const Robot& robot, const BaseFitRow& row, double hei
           {std::numbers::pi - std::atan2(h, v1) - (t1 + v1) / h, h / t1 + v1 * (t1 + v1) / (h * t1)});
     // Encoder scale s_i: P (1 + s_i) on its own cable's reading.
     if (double* scale = at(Effect::kEncoderScale)) scale[enc_row * kCableCount + i] = l0 / sigma_encoder;
-    // CoM offset: the statics' own columns (the forces move), chained
-    // through the catenary as the pose's are.
+    // How the payout and the height residual move per unit of statics
+    // parameter s (the forces, span and anchor height move), chained through
+    // the catenary as the pose's columns are.
+    const auto payout_by = [&](int s) {
+      return dp(0) * c.d_f_h(s) + dp(1) * c.d_f_v(s) + dp(2) * c.d_span(s) + dp(3) * c.d_anchor_z(s);
+    };
+    const auto height_by = [&](int s) {
+      return c.d_attachment_z(s) - (de(0) * c.d_f_h(s) + de(1) * c.d_f_v(s) + de(2) * c.d_span(s) + de(3) * c.d_anchor_z(s));
+    };
+    // CoM offset: the statics' own columns.
     if (double* com = at(Effect::kComOffset)) {
       for (int a = 0; a < 3; ++a) {
-        const int s = kStaticsCom + a;
-        com[enc_row * 3 + a] =
-            (dp(0) * c.d_f_h(s) + dp(1) * c.d_f_v(s) + dp(2) * c.d_span(s) + dp(3) * c.d_anchor_z(s)) / sigma_encoder;
-        com[height_row * 3 + a] = (c.d_attachment_z(s) - (de(0) * c.d_f_h(s) + de(1) * c.d_f_v(s) +
-                                                          de(2) * c.d_span(s) + de(3) * c.d_anchor_z(s))) /
-                                  sigma_height;
+        com[enc_row * 3 + a] = payout_by(kStaticsCom + a) / sigma_encoder;
+        com[height_row * 3 + a] = height_by(kStaticsCom + a) / sigma_height;
+      }
+    }
+    // Pose reference offset d: the platform origin is p - R d, so d's
+    // columns are the origin's times -R (effect_pose_factor.cc).
+    if (double* reference = at(Effect::kPoseReferenceOffset)) {
+      for (int a = 0; a < 3; ++a) {
+        double payout = 0.0, height = 0.0;
+        for (int b = 0; b < 3; ++b) {
+          payout -= payout_by(kStaticsPose + b) * world_R_platform(b, a);
+          height -= height_by(kStaticsPose + b) * world_R_platform(b, a);
+        }
+        reference[enc_row * 3 + a] = payout / sigma_encoder;
+        reference[height_row * 3 + a] = height / sigma_height;
       }
     }
   }

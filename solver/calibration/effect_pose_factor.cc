@@ -13,12 +13,36 @@ namespace {
 
 using StatRow = Eigen::Matrix<double, 1, kStaticsParamDim>;
 
+// With a pose reference offset d the pose variable (p, R) is the
+// localization's reference point and the statics see the platform origin
+// p' = p - R d. Perturbing R by Exp(dtheta) moves p' by R [d]x dtheta, so a
+// row's rotation columns gain (its p' columns) R [d]x and d's own columns
+// are -(its p' columns) R. Inactive (d = 0, no block): the pose's own.
+struct ReferenceOffset {
+  Eigen::Matrix3d world_R_platform = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d rotation_gain = Eigen::Matrix3d::Zero();  // R [d]x
+  double* block = nullptr;                                  // d's Jacobian block, if modelled
+};
+
 // Copies the statics-parameter columns of one residual row into the
 // Jacobian blocks of pose, reference force, anchors and (if modelled) the
-// CoM offset; offsets get 0 here and their entry separately.
-void scatter_statics(const StatRow& row, int r, double* const* jacobians, double* com_block) {
+// CoM offset and the pose reference offset; offsets get 0 here and their
+// entry separately.
+void scatter_statics(const StatRow& row, int r, double* const* jacobians, double* com_block,
+                     const ReferenceOffset& reference) {
   static_assert(kStaticsPose == 0 && kStaticsForce == 6 && kStaticsAnchor == 8 && kStaticsCom == 20);
-  if (jacobians[0]) for (int c = 0; c < 6; ++c) jacobians[0][r * 6 + c] = row(kStaticsPose + c);
+  const Eigen::RowVector3d origin = row.segment<3>(kStaticsPose);
+  if (jacobians[0]) {
+    const Eigen::RowVector3d rotation = row.segment<3>(kStaticsPose + 3) + origin * reference.rotation_gain;
+    for (int c = 0; c < 3; ++c) {
+      jacobians[0][r * 6 + c] = origin(c);
+      jacobians[0][r * 6 + 3 + c] = rotation(c);
+    }
+  }
+  if (reference.block) {
+    const Eigen::RowVector3d d_offset = -origin * reference.world_R_platform;
+    for (int c = 0; c < 3; ++c) reference.block[r * 3 + c] = d_offset(c);
+  }
   if (jacobians[1]) for (int c = 0; c < 2; ++c) jacobians[1][r * 2 + c] = row(kStaticsForce + c);
   for (int i = 0; i < kCableCount; ++i) {
     if (jacobians[2 + i]) for (int c = 0; c < 3; ++c) jacobians[2 + i][r * 3 + c] = row(kStaticsAnchor + 3 * i + c);
@@ -96,9 +120,17 @@ bool EffectPoseFactor::evaluate_model(const double* const* parameters, double* r
   const double* density = effect_parameter(parameters, Effect::kDensityError);
   const double* kappa = effect_parameter(parameters, Effect::kElasticity);
   const double* radius = effect_parameter(parameters, Effect::kPulleyRadius);
+  const double* reference_offset = effect_parameter(parameters, Effect::kPoseReferenceOffset);
 
   StaticsInput in;
   in.world_T_platform = pose_from_parameters(parameters[0]);
+  ReferenceOffset reference;
+  if (reference_offset) {
+    const Eigen::Vector3d d(reference_offset[0], reference_offset[1], reference_offset[2]);
+    reference.world_R_platform = in.world_T_platform.world_R_platform.toRotationMatrix();
+    reference.rotation_gain = reference.world_R_platform * skew(d);
+    in.world_T_platform.position_world -= reference.world_R_platform * d;
+  }
   in.reference_force = Eigen::Vector2d(parameters[1][0], parameters[1][1]);
   for (int i = 0; i < kCableCount; ++i) {
     in.anchor_world[i] = Eigen::Vector3d(parameters[2 + i][0], parameters[2 + i][1], parameters[2 + i][2]);
@@ -118,6 +150,7 @@ bool EffectPoseFactor::evaluate_model(const double* const* parameters, double* r
   double* const density_block = effect_jacobian(jacobians, Effect::kDensityError);
   double* const kappa_block = effect_jacobian(jacobians, Effect::kElasticity);
   double* const radius_block = effect_jacobian(jacobians, Effect::kPulleyRadius);
+  reference.block = effect_jacobian(jacobians, Effect::kPoseReferenceOffset);
 
   const double nominal_weight = robot_.gravity_mps2 * robot_.cable_linear_density_kgpm;
   for (int i = 0; i < kCableCount; ++i) {
@@ -142,9 +175,9 @@ bool EffectPoseFactor::evaluate_model(const double* const* parameters, double* r
     }
     if (!with_jacobian) continue;
 
-    scatter_statics(gain_i * chain(shape.d_payout, c) / sigma_encoder, enc_row, jacobians, com_block);
+    scatter_statics(gain_i * chain(shape.d_payout, c) / sigma_encoder, enc_row, jacobians, com_block, reference);
     scatter_statics((c.d_attachment_z - chain(shape.d_end_height, c)) / sigma_height_m_, height_row, jacobians,
-                    com_block);
+                    com_block, reference);
     if (jacobians[2 + kCableCount + i]) jacobians[2 + kCableCount + i][enc_row] = 1.0 / sigma_encoder;
     if (scale_block) scale_block[enc_row * kCableCount + i] = shape.payout / sigma_encoder;
     // Scalar effects of the cable shape, through the cable model's own columns.
@@ -174,7 +207,7 @@ bool EffectPoseFactor::evaluate_model(const double* const* parameters, double* r
       row(kStaticsForce) = force_gain * in.reference_force.x() / (tension * sigma_force);
       row(kStaticsForce + 1) = force_gain * in.reference_force.y() / (tension * sigma_force);
     }
-    scatter_statics(row, force_row, jacobians, com_block);
+    scatter_statics(row, force_row, jacobians, com_block, reference);
     if (double* J = effect_jacobian(jacobians, Effect::kLoadCell)) {
       J[force_row * 2] = 1.0 / sigma_force;
       J[force_row * 2 + 1] = tension / sigma_force;

@@ -6,7 +6,9 @@
 //   height i:   (b_z,i - z_i) / sigma_height
 //   force:      ((1 + g) |(f_h, f_v)_ref| + b - z_force) / sigma_force (b of load_cell or load_cell_bias)
 // payout_i and z_i from solver/model/effect_cable.h (elasticity, density error,
-// swivel pulley), the statics with the weight at the nominal CoM + c.
+// swivel pulley), the statics with the weight at the nominal CoM + c and, with
+// a pose reference offset d, the platform origin at p - R d (the pose
+// variable is then the localization's reference point; effects.h).
 // With no effects it is the base catenary model (payout = arc length).
 // The Loss applies to the reading rows only (solver/calibration/pose_factor_rows.h).
 //

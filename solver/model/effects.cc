@@ -1,61 +1,50 @@
 #include "solver/model/effects.h"
 
 #include <cmath>
+#include <cstdio>
 
 namespace cdpr {
 
-std::string_view effect_model_name(Effect e) {
-  switch (e) {
-    case Effect::kElasticity: return "elasticity";
-    case Effect::kEncoderScale: return "encoder_scale";
-    case Effect::kLoadCell: return "load_cell";
-    case Effect::kComOffset: return "com_offset";
-    case Effect::kDensityError: return "density_error";
-    case Effect::kPulleyRadius: return "pulley_radius";
-    case Effect::kLoadCellBias: return "load_cell_bias";
-  }
-  return "?";
+namespace effect_rows {
+
+// EA = 1 / (kappa * 1e-6); sigma by first order: sigma_EA = sigma_kappa * EA / kappa.
+void elasticity_value(double kappa, double kappa_sigma, double& ea, double& ea_sigma) {
+  ea = 1.0 / (kappa * kComplianceScale);
+  ea_sigma = std::abs(ea / kappa) * kappa_sigma;
 }
+
+}  // namespace effect_rows
+
+std::string_view effect_model_name(Effect e) { return effect_descriptor(e).name; }
 
 std::vector<std::string> effect_value_names(Effect e) {
-  if (e == Effect::kElasticity) return {"axial_stiffness"};
-  if (e == Effect::kLoadCell) return {"force_bias", "force_gain"};
-  if (e == Effect::kLoadCellBias) return {"force_bias"};
-  return {std::string(effect_model_name(e))};
+  const EffectDescriptor& d = effect_descriptor(e);
+  std::vector<std::string> names;
+  for (int v = 0; v < d.value_count; ++v) names.emplace_back(d.values[v].name);
+  return names;
 }
 
-std::optional<Effect> effect_from_model_name(std::string_view name) {
-  for (Effect e : kAllEffects) {
-    if (effect_model_name(e) == name) return e;
+std::optional<std::string_view> effect_value_unit(std::string_view value_name) {
+  for (const EffectDescriptor& d : kEffectCatalogue) {
+    for (int v = 0; v < d.value_count; ++v) {
+      if (d.values[v].name == value_name) return d.values[v].unit;
+    }
   }
   return std::nullopt;
 }
 
-int effect_dimension(Effect e) {
-  switch (e) {
-    case Effect::kEncoderScale: return 4;
-    case Effect::kComOffset: return 3;
-    case Effect::kLoadCell: return 2;
-    default: return 1;
+std::optional<Effect> effect_from_model_name(std::string_view name) {
+  for (const EffectDescriptor& d : kEffectCatalogue) {
+    if (d.name == name) return d.effect;
   }
+  return std::nullopt;
 }
 
-std::string_view effect_description(Effect e) {
-  switch (e) {
-    case Effect::kElasticity: return "cable elasticity: encoders count unstretched cable (elastic catenary, EA)";
-    case Effect::kEncoderScale: return "encoder scale per cable: reading = (1 + s_i) payout + offset";
-    case Effect::kLoadCell: return "load-cell bias and gain: reading = (1 + g) tension + b";
-    case Effect::kComOffset: return "centre-of-mass offset: the weight acts at the nominal CoM + c";
-    case Effect::kDensityError: return "cable density error: density = nominal (1 + r)";
-    case Effect::kPulleyRadius: return "swivel-pulley radius: the cable wraps a pulley of radius r at the anchor";
-    case Effect::kLoadCellBias: return "load-cell bias alone (gain right): reading = tension + b";
-  }
-  return "?";
-}
+int effect_dimension(Effect e) { return effect_descriptor(e).dimension; }
 
-bool effect_contains(Effect wide, Effect narrow) {
-  return wide == Effect::kLoadCell && narrow == Effect::kLoadCellBias;
-}
+std::string_view effect_description(Effect e) { return effect_descriptor(e).description; }
+
+bool effect_contains(Effect wide, Effect narrow) { return effect_descriptor(wide).contains == narrow; }
 
 std::string effect_set_conflict(const std::vector<Effect>& effects) {
   for (std::size_t a = 0; a < effects.size(); ++a) {
@@ -71,39 +60,45 @@ std::string effect_set_conflict(const std::vector<Effect>& effects) {
 }
 
 std::string effect_domain_violation(Effect e, const std::vector<double>& value, const std::vector<double>& sigma) {
-  const auto below_zero = [&](const char* what) -> std::string {
-    if (value.at(0) < -3.0 * sigma.at(0)) return std::string(what) + " below zero by more than 3 sigma";
-    return {};
-  };
-  switch (e) {
-    case Effect::kElasticity: return below_zero("compliance 1/EA");
-    case Effect::kPulleyRadius: return below_zero("pulley radius");
-    case Effect::kDensityError: return value.at(0) <= -1.0 ? "cable density not positive" : "";
-    case Effect::kLoadCell: return value.at(1) <= -1.0 ? "load-cell gain factor not positive" : "";
-    default: return {};
+  const EffectDomain& domain = effect_descriptor(e).domain;
+  const std::size_t j = static_cast<std::size_t>(domain.parameter);
+  switch (domain.rule) {
+    case EffectDomainRule::kAny: return {};
+    case EffectDomainRule::kNotBelowZero:
+      return value.at(j) < -3.0 * sigma.at(j) ? std::string(domain.what) + " below zero by more than 3 sigma" : "";
+    case EffectDomainRule::kPositiveFactor:
+      return value.at(j) <= -1.0 ? std::string(domain.what) + " not positive" : "";
+    case EffectDomainRule::kComponentsWithin:
+      for (std::size_t k = 0; k < value.size(); ++k) {
+        if (std::abs(value[k]) - 3.0 * sigma.at(k) > domain.limit) {
+          char limit[32];
+          std::snprintf(limit, sizeof limit, "%g", domain.limit);
+          const std::string_view unit = effect_descriptor(e).values[0].unit;
+          return std::string(domain.what) + " beyond " + limit + " " + std::string(unit) + " by more than 3 sigma";
+        }
+      }
+      return {};
   }
+  return {};
 }
 
 void add_effect_values(Effect e, const std::vector<double>& parameter, const std::vector<double>& parameter_sigma,
                        EffectValues& out) {
-  const std::string name = effect_value_names(e).front();
-  if (e == Effect::kLoadCell) {
-    out["force_bias"] = {parameter.at(0)};
-    out["force_bias_sigma"] = {parameter_sigma.at(0)};
-    out["force_gain"] = {parameter.at(1)};
-    out["force_gain_sigma"] = {parameter_sigma.at(1)};
-    return;
+  const EffectDescriptor& d = effect_descriptor(e);
+  std::size_t first = 0;
+  for (int v = 0; v < d.value_count; ++v) {
+    const EffectValueSpec& spec = d.values[v];
+    const std::string name(spec.name);
+    const auto begin = static_cast<std::ptrdiff_t>(first), end = begin + spec.size;
+    std::vector<double> value(parameter.begin() + begin, parameter.begin() + end);
+    std::vector<double> sigma(parameter_sigma.begin() + begin, parameter_sigma.begin() + end);
+    if (d.physical) {
+      for (std::size_t j = 0; j < value.size(); ++j) d.physical(value[j], sigma[j], value[j], sigma[j]);
+    }
+    out[name] = std::move(value);
+    out[name + "_sigma"] = std::move(sigma);
+    first += static_cast<std::size_t>(spec.size);
   }
-  if (e == Effect::kElasticity) {
-    // EA = 1 / (kappa * 1e-6); sigma by first order: sigma_EA = sigma_kappa * EA / kappa.
-    const double kappa = parameter.at(0);
-    const double ea = 1.0 / (kappa * kComplianceScale);
-    out[name] = {ea};
-    out[name + "_sigma"] = {std::abs(ea / kappa) * parameter_sigma.at(0)};
-    return;
-  }
-  out[name] = parameter;
-  out[name + "_sigma"] = parameter_sigma;
 }
 
 }  // namespace cdpr

@@ -69,8 +69,10 @@ std::string model_text(const std::vector<std::string>& model) {
 }
 
 std::string effect_unit(const std::string& name) {
-  if (name == "axial_stiffness" || name == "force_bias" || name == "wind_force") return "N";
-  if (name == "com_offset" || name == "pulley_radius" || name == "encoder_drift") return "m";
+  if (const auto unit = effect_value_unit(name)) return std::string(*unit);
+  // The simulator's truth.toml also names effects no model term describes.
+  if (name == "wind_force") return "N";
+  if (name == "encoder_drift") return "m";
   return "";
 }
 

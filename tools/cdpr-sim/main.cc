@@ -78,7 +78,7 @@ bool write_file(const std::filesystem::path& path, const std::string& text) {
 struct Args {
   std::string preset = "large";
   std::string out_dir;
-  std::string encoder_scale, encoder_drift, com_offset, wind, workspace, extra_positions;
+  std::string encoder_scale, encoder_drift, com_offset, pose_reference_offset, wind, workspace, extra_positions;
   std::string encoder_outlier_range = "0.5,2", force_spike_range = "50,500";
   std::uint64_t seed = 1;
 };
@@ -113,6 +113,8 @@ int main(int argc, char** argv) {
   app.add_option("--force-bias", config.effects.force_bias_n, "hidden load-cell bias b [N]: reading = (1 + g) * tension + b");
   app.add_option("--force-gain", config.effects.force_gain, "hidden load-cell gain error g");
   app.add_option("--com-offset", args.com_offset, "hidden centre-of-mass offset x,y,z [m, platform frame]");
+  app.add_option("--pose-reference-offset", args.pose_reference_offset,
+                 "the localization's reference point x,y,z [m, platform frame]: it reports the pose of that point");
   app.add_option("--density-error", config.effects.density_error, "hidden cable density error r: true = nominal * (1 + r)")
       ->check(CLI::Range(-0.9, 10.0));
   app.add_flag_callback("--weightless-cables", [&config] { config.effects.density_error = -1.0; },
@@ -173,6 +175,9 @@ int main(int argc, char** argv) {
     return 1;
   }
   for (auto [text, target, name] : {std::tuple{&args.com_offset, &config.effects.com_offset_platform, "--com-offset"},
+                                    std::tuple{&args.pose_reference_offset,
+                                               &config.effects.pose_reference_offset_platform,
+                                               "--pose-reference-offset"},
                                     std::tuple{&args.wind, &config.effects.wind_force_world_n, "--wind"}}) {
     if (text->empty()) continue;
     if (!parse_list(*text, 3, values)) {

@@ -17,7 +17,9 @@ Sample measure(const TrueRobot& robot, const Equilibrium& state, double noise_sc
   sample.id = sample_id;
   // Fixed draw order (position, rotation, encoders, force) keeps a seed's
   // numbers the same whatever the values.
-  sample.position_world = state.world_T_platform.position_world + normal3(rng, noise_scale * sigma.position_m);
+  const Pose& pose = state.world_T_platform;
+  sample.position_world = pose.transform(effects.pose_reference_offset_platform) +
+                          normal3(rng, noise_scale * sigma.position_m);
   const Eigen::Vector3d rotation_noise = normal3(rng, noise_scale * sigma.orientation_rad);
   sample.world_R_platform = (state.world_T_platform.world_R_platform * so3_exp(rotation_noise)).normalized();
   for (int i = 0; i < kCableCount; ++i) {

@@ -24,6 +24,9 @@ EffectValues effect_values(const HiddenEffects& e) {
   if (!e.com_offset_platform.isZero(0.0)) values["com_offset"] = values_of(e.com_offset_platform);
   if (e.density_error != 0.0) values["density_error"] = {e.density_error};
   if (e.pulley_radius_m != 0.0) values["pulley_radius"] = {e.pulley_radius_m};
+  if (!e.pose_reference_offset_platform.isZero(0.0)) {
+    values["pose_reference_offset"] = values_of(e.pose_reference_offset_platform);
+  }
   if (!e.wind_force_world_n.isZero(0.0)) values["wind_force"] = values_of(e.wind_force_world_n);
   return values;
 }
@@ -52,6 +55,7 @@ HiddenEffects hidden_effects_of(const EffectValues& values) {
   if (const auto* v = value("com_offset", 3)) e.com_offset_platform = vector3(*v);
   if (const auto* v = value("density_error", 1)) e.density_error = (*v)[0];
   if (const auto* v = value("pulley_radius", 1)) e.pulley_radius_m = (*v)[0];
+  if (const auto* v = value("pose_reference_offset", 3)) e.pose_reference_offset_platform = vector3(*v);
   if (const auto* v = value("wind_force", 3)) e.wind_force_world_n = vector3(*v);
   return e;
 }

@@ -32,6 +32,9 @@ struct HiddenEffects {
   double density_error = 0.0;
   // Swivel pulley radius [m] (sim/swivel_pulley.h); 0 = plain anchor point.
   double pulley_radius_m = 0.0;
+  // The localization's reference point [m, platform frame]: the measured
+  // position is the platform origin + R * offset.
+  Eigen::Vector3d pose_reference_offset_platform = Eigen::Vector3d::Zero();
   // The "unknown" effect no model term describes: a constant force [N, world]
   // on the platform, acting at its centre of mass (wind).
   Eigen::Vector3d wind_force_world_n = Eigen::Vector3d::Zero();
@@ -57,7 +60,7 @@ struct TrueRobot {
 // The [effects] table of truth.toml (docs/FORMATS.md): only effects that are
 // present, by name: axial_stiffness [N], encoder_scale (4), encoder_drift (4) [m], force_bias [N],
 // force_gain, com_offset (3) [m], density_error, pulley_radius [m],
-// wind_force (3) [N].
+// pose_reference_offset (3) [m], wind_force (3) [N].
 EffectValues effect_values(const HiddenEffects& effects);
 
 // truth.toml content: true anchors, offsets and effects.

@@ -69,6 +69,14 @@ TEST(EffectModel, LoadCellBiasAloneReproducesTheSimulator) {
   expect_exact_recovery(config, {Effect::kElasticity, Effect::kLoadCellBias});
 }
 
+TEST(EffectModel, PoseReferenceOffsetReproducesTheSimulator) {
+  // GIVEN a localization that reports the pose of a point 5 cm off the platform origin
+  sim::DatasetConfig config = noiseless_large();
+  config.effects.pose_reference_offset_platform = Eigen::Vector3d(0.03, 0.0, 0.04);
+  // WHEN fitted with the pose reference offset, THEN the readings, the anchors and the offset come back exactly
+  expect_exact_recovery(config, {Effect::kPoseReferenceOffset});
+}
+
 TEST(EffectModel, RefusesTwoFormsOfTheLoadCellTermInOneModel) {
   // GIVEN a model with both load_cell (bias and gain) and load_cell_bias, whose biases could not be told apart
   auto data = sim::simulate_dataset(noiseless_large());

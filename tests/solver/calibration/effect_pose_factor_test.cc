@@ -21,6 +21,7 @@ std::vector<double> effect_value(Effect e) {
     case Effect::kDensityError: return {0.05};
     case Effect::kPulleyRadius: return {0.15};
     case Effect::kLoadCellBias: return {15.0};
+    case Effect::kPoseReferenceOffset: return {0.04, -0.03, 0.05};
   }
   return {};
 }
