@@ -259,7 +259,7 @@ TEST_F(CanopenWinchBankTest, HeartbeatLossStopsEveryWinchAlongTheCommandedLine) 
 TEST_F(CanopenWinchBankTest, DriveLeftInHomingModeIsSwitchedToProfilePosition) {
   // GIVEN drives that power on in homing mode (0x6060 = 6)
   virtual_robot::DriveDefaults homing;
-  homing.power_on_mode = 6;
+  homing.stored[virtual_robot::object_key(0x6060, 0)] = 6;
   start(two_winches(), homing);
   // WHEN enabled and sent 0.2 m
   open_and_enable();
@@ -276,7 +276,7 @@ TEST_F(CanopenWinchBankTest, DriveThatSwitchesModeLateIsEnabledOnceItShowsTheMod
   // GIVEN drives in homing mode that show a new mode in 0x6061 only 150 ms
   // after 0x6060 is written (drives switch asynchronously)
   virtual_robot::DriveDefaults homing;
-  homing.power_on_mode = 6;
+  homing.stored[virtual_robot::object_key(0x6060, 0)] = 6;
   start(two_winches(), homing);
   bus_->set_mode_switch_delay(150'000);
   // WHEN enabled
@@ -299,7 +299,7 @@ TEST_F(CanopenWinchBankTest, DriveThatNeverShowsTheModeIsRefusedAfterTheTimeout)
   CanWinchBankConfig config = two_winches();
   config.mode_switch_timeout_us = 200'000;
   virtual_robot::DriveDefaults homing;
-  homing.power_on_mode = 6;
+  homing.stored[virtual_robot::object_key(0x6060, 0)] = 6;
   start(config, homing);
   bus_->set_mode_switch_delay(10'000'000);
   // WHEN enabled
@@ -346,9 +346,10 @@ TEST_F(CanopenWinchBankTest, RefusedWriteNamesTheAbortCode) {
   start(config);
   ASSERT_TRUE(bank_->open().ok());
   run_ms(500);
-  // THEN the configuration stops there with the device's abort code
+  // THEN the configuration stops there with the device's abort code (its EDS says LowLimit=1)
   EXPECT_TRUE(bank_->status(0).fault);
-  EXPECT_NE(bank_->fault_text(0).find("node 1 SDO write 0x6081:0x00: abort 0x06090030 (invalid value for parameter)"),
+  EXPECT_NE(bank_->fault_text(0).find(
+                "node 1 SDO write 0x6081:0x00: abort 0x06090032 (value of parameter written too low)"),
             std::string::npos)
       << bank_->fault_text(0);
 }
@@ -620,8 +621,7 @@ TEST_F(CanopenWinchBankTest, EncoderWithTwoTpdosIsConfigured) {
   // GIVEN encoders with only two TPDOs (0x1802/0x1803 and 0x1A02/0x1A03 do
   // not exist: abort 0x06020000) and no RPDO, as Kübler Sendix and SIKO come
   virtual_robot::EncoderDefaults encoder;
-  encoder.quirks.tpdo_count = 2;
-  encoder.quirks.rpdo_count = 0;
+  encoder.eds = virtual_robot::shipped_eds("cdpr-virtual-encoder-two-tpdo.eds");
   start(two_winches(), {}, encoder);
   // WHEN the bank configures them THEN they are alive without a fault, TPDO2 switched off
   open_and_configure();
@@ -634,7 +634,7 @@ TEST_F(CanopenWinchBankTest, EncoderWithTwoTpdosIsConfigured) {
 TEST_F(CanopenWinchBankTest, DriveKeepingCobIdBit30IsConfigured) {
   // GIVEN drives that hold COB-ID bit 30 at 1 (no RTR) whatever is written, as Lika's manual requires
   virtual_robot::DriveDefaults drive;
-  drive.quirks.cob_id_bit30_fixed = true;
+  drive.eds = virtual_robot::shipped_eds("cdpr-virtual-drive-rtr-bit30.eds");
   start(two_winches(), drive);
   // WHEN the bank configures them THEN the read back 0x40000201 matches the 0x201 written
   open_and_configure();
@@ -653,7 +653,7 @@ TEST_F(CanopenWinchBankTest, DriveKeepingCobIdBit30IsConfigured) {
 TEST_F(CanopenWinchBankTest, DriveWithoutTransmissionType255GetsType254) {
   // GIVEN drives that refuse transmission type 255 (abort 0x06090030)
   virtual_robot::DriveDefaults drive;
-  drive.quirks.no_type_255 = true;
+  drive.eds = virtual_robot::shipped_eds("cdpr-virtual-drive-no-type-255.eds");
   start(two_winches(), drive);
   // WHEN the bank configures them THEN their PDOs are event-driven on type 254 and they are alive
   open_and_configure();
@@ -668,9 +668,9 @@ constexpr double kMPerMotorRev = 3.14159265358979323846 * 0.02 / 10.0;
 
 virtual_robot::DriveDefaults rpm_drive() {
   virtual_robot::DriveDefaults drive;
-  drive.rpm_units = true;
+  drive.eds = virtual_robot::shipped_eds("cdpr-virtual-drive-rpm.eds");
   drive.counts_per_rev = kMPerMotorRev / kDriveMPerCount;
-  drive.max_motor_speed_rpm = 60'000;
+  drive.stored[virtual_robot::object_key(0x6080, 0)] = 60'000;
   return drive;
 }
 
@@ -718,7 +718,7 @@ TEST_F(CanopenWinchBankTest, DriveInRpmWithoutMechanicsIsRefusedNamingTheNode) {
 TEST_F(CanopenWinchBankTest, ProfileAboveMaxMotorSpeedIsRefused) {
   // GIVEN drives in rpm whose 0x6080 allows 30000 rpm, and a profile velocity of 4 m/s (38197 rpm)
   virtual_robot::DriveDefaults drive = rpm_drive();
-  drive.max_motor_speed_rpm = 30'000;
+  drive.stored[virtual_robot::object_key(0x6080, 0)] = 30'000;
   start(rpm_winches(), drive);
   ASSERT_TRUE(bank_->open().ok());
   run_ms(300);
@@ -730,11 +730,45 @@ TEST_F(CanopenWinchBankTest, ProfileAboveMaxMotorSpeedIsRefused) {
       << bank_->fault_text(0);
 }
 
+TEST_F(CanopenWinchBankTest, EveryShippedVirtualDeviceEdsBuildsADeviceTheMasterConfiguresFromThatFile) {
+  // GIVEN each virtual device's EDS of systemd/eds, played by the devices
+  // (built in) and read by the master from the file, the others plain
+  struct Case {
+    const char* drive_eds;
+    const char* encoder_eds;
+  };
+  for (const Case c : {Case{"cdpr-virtual-drive.eds", "cdpr-virtual-encoder.eds"},
+                       Case{"cdpr-virtual-drive-rtr-bit30.eds", "cdpr-virtual-encoder.eds"},
+                       Case{"cdpr-virtual-drive-no-type-255.eds", "cdpr-virtual-encoder.eds"},
+                       Case{"cdpr-virtual-drive-rpm.eds", "cdpr-virtual-encoder.eds"},
+                       Case{"cdpr-virtual-drive.eds", "cdpr-virtual-encoder-two-tpdo.eds"}}) {
+    SCOPED_TRACE(std::string(c.drive_eds) + " + " + c.encoder_eds);
+    virtual_robot::DriveDefaults drive = rpm_drive();
+    drive.eds = virtual_robot::shipped_eds(c.drive_eds);
+    drive.stored.clear();
+    virtual_robot::EncoderDefaults encoder;
+    encoder.eds = virtual_robot::shipped_eds(c.encoder_eds);
+    CanWinchBankConfig config = rpm_winches();
+    config.drive.profile_velocity_mps = 1.0;  // 9549 rpm: below the rpm drive's 0x6080 of 10000
+    config.drive.eds = std::string(CDPR_SOURCE_DIR) + "/systemd/eds/" + c.drive_eds;
+    config.encoder.eds = std::string(CDPR_SOURCE_DIR) + "/systemd/eds/" + c.encoder_eds;
+    start(config, drive, encoder);
+    ASSERT_EQ(bank_->setup_error(), "");
+    // WHEN configured, enabled and moved 0.2 m THEN no fault, and on target
+    open_and_enable();
+    const double start_m = bank_->status(0).payout_m;
+    ASSERT_TRUE(bank_->set_target_payout(0, start_m + 0.2).ok());
+    run_ms(800);
+    EXPECT_TRUE(bank_->motion_finished());
+    EXPECT_NEAR(bank_->status(0).payout_m, start_m + 0.2, kEncoderMPerCount);
+    for (int i = 0; i < 2; ++i) EXPECT_FALSE(bank_->status(i).fault) << bank_->fault_text(i);
+  }
+}
+
 TEST_F(CanopenWinchBankTest, EncoderDescribedByItsEdsIsNotAskedForPdosItLacks) {
   // GIVEN 2-TPDO encoders and their EDS in the configuration
   virtual_robot::EncoderDefaults encoder;
-  encoder.quirks.tpdo_count = 2;
-  encoder.quirks.rpdo_count = 0;
+  encoder.eds = virtual_robot::shipped_eds("cdpr-virtual-encoder-two-tpdo.eds");
   CanWinchBankConfig config = two_winches();
   config.encoder.eds = std::string(CDPR_SOURCE_DIR) + "/systemd/eds/kuebler-sendix.eds";
   start(config, {}, encoder);
@@ -792,7 +826,7 @@ TEST_F(CanopenWinchBankTest, SoftwarePositionLimitsFollowThePayoutRange) {
 TEST_F(CanopenWinchBankTest, ReplacementEncoderCountingTheOtherWayIsRefused) {
   // GIVEN the configuration's code sequence 0 (counting up clockwise) and encoders set to 1
   virtual_robot::EncoderDefaults encoder;
-  encoder.operating_parameters = 0x0001;
+  encoder.stored[virtual_robot::object_key(0x6000, 0)] = 0x0001;
   CanWinchBankConfig config = two_winches();
   config.encoder.code_sequence = 0;
   config.encoder.counts_per_revolution = 4096;

@@ -53,6 +53,7 @@ Eigen::Vector3d start_position_world(sim::Preset preset) {
 
 Expected<std::unique_ptr<VirtualRobot>, std::string> VirtualRobot::create(const VirtualRobotOptions& options) {
   if (!(options.time_scale > 0.0)) return Unexpected{std::string("time scale must be > 0")};
+  if (std::string why = CanopenNodes::check(options.nodes); !why.empty()) return Unexpected{"CANopen nodes: " + why};
   auto data = sim::simulate_dataset(dataset_config(options));
   if (!data) return Unexpected{"simulated robot: " + data.error()};
   auto robot = std::unique_ptr<VirtualRobot>(new VirtualRobot(options, std::move(*data)));
