@@ -66,6 +66,10 @@ struct CanWinchConfig {
   int encoder_node_id = 0;           // 1..127, != drive; 0: no encoder node, use the drive's position
   double encoder_m_per_count = 0.0;  // payout [m] per encoder count, sign gives direction; != 0
   double drive_m_per_count = 0.0;    // payout [m] per drive position count; != 0
+  // This winch's drive's and encoder's EDS where they differ from the
+  // others' (a replaced or another make of device); empty: DriveDescription::eds / EncoderDescription::eds.
+  std::string drive_eds = {};
+  std::string encoder_eds = {};
 };
 
 // The winch between motor and cable, for drives that count motor

@@ -27,8 +27,8 @@ void CanopenWinchBank::fit_to_devices() {
   for (std::size_t i = 0; i < winches_.size() && setup_error_.empty(); ++i) {
     Winch& w = winches_[i];
     const CanWinchConfig& c = config_.winches[i];
-    load_eds(w.drive_node, config_.drive.eds, loaded);
-    if (c.encoder_node_id != 0) load_eds(w.encoder_node, config_.encoder.eds, loaded);
+    load_eds(w.drive_node, c.drive_eds.empty() ? config_.drive.eds : c.drive_eds, loaded);
+    if (c.encoder_node_id != 0) load_eds(w.encoder_node, c.encoder_eds.empty() ? config_.encoder.eds : c.encoder_eds, loaded);
     if (!setup_error_.empty()) break;
     std::string why;
     if (w.drive_node.eds) {

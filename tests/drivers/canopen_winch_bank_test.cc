@@ -765,6 +765,39 @@ TEST_F(CanopenWinchBankTest, EveryShippedVirtualDeviceEdsBuildsADeviceTheMasterC
   }
 }
 
+TEST_F(CanopenWinchBankTest, AWinchWhoseDriveDiffersIsConfiguredFromItsOwnEds) {
+  // GIVEN winch 0 with the virtual drive (counts/s) and winch 1 with a drive
+  // in rpm, each named by its EDS: [winches.drive] eds and winch 1's drive_eds
+  CanWinchBankConfig config = rpm_winches();
+  config.drive.profile_velocity_mps = 1.0;  // 9549 rpm, within the rpm drive's 0x6080
+  config.drive.eds = std::string(CDPR_SOURCE_DIR) + "/systemd/eds/cdpr-virtual-drive.eds";
+  config.winches[1].drive_eds = std::string(CDPR_SOURCE_DIR) + "/systemd/eds/cdpr-virtual-drive-rpm.eds";
+  int fds[2];
+  ASSERT_EQ(::socketpair(AF_UNIX, SOCK_STREAM, 0, fds), 0);
+  bus_ = std::make_unique<test::FakeCanopenBus>(fds[1]);
+  bus_->add(1, 11);
+  virtual_robot::DriveDefaults rpm = rpm_drive();
+  rpm.stored.clear();
+  bus_->add(2, 12, rpm);
+  const int bank_fd = fds[0];
+  bank_ = std::make_unique<CanopenWinchBank>(config, [bank_fd]() -> hal::Result<std::unique_ptr<CanTransport>> {
+    return std::unique_ptr<CanTransport>(std::make_unique<FdCanTransport>(bank_fd, "test bank"));
+  });
+  ASSERT_EQ(bank_->setup_error(), "");
+  EXPECT_EQ(bank_->nodes_without_eds(), "encoders 11, 12");
+  // WHEN configured THEN each drive has 1 m/s in its own unit: 5000 counts/s and 9549 rpm
+  open_and_configure();
+  EXPECT_EQ(bus_->drive(0).od().get(0x6081, 0), 5000u);
+  EXPECT_EQ(bus_->drive(1).od().get(0x6081, 0), 9549u);
+  // AND a coordinated move takes both to their targets
+  ASSERT_TRUE(bank_->enable().ok());
+  run_ms(100);
+  const double to_m[2] = {bank_->status(0).payout_m + 0.4, bank_->status(1).payout_m + 0.2};
+  ASSERT_TRUE(bank_->set_target_payouts(to_m).ok());
+  run_ms(1000);
+  for (int i = 0; i < 2; ++i) EXPECT_NEAR(bank_->status(i).payout_m, to_m[i], kEncoderMPerCount) << "winch " << i;
+}
+
 TEST_F(CanopenWinchBankTest, EncoderDescribedByItsEdsIsNotAskedForPdosItLacks) {
   // GIVEN 2-TPDO encoders and their EDS in the configuration
   virtual_robot::EncoderDefaults encoder;
