@@ -210,9 +210,12 @@ class CanopenWinchBank final : public hal::WinchBank {
   hal::Status service_node(Winch& winch, Node& node, hal::TimeUs now_us);
   // The probe's answers made into `node.steps`; empty, else why the node cannot be configured.
   std::string configure_from_probe(Winch& winch, Node& node);
-  // The drive's steps for the units its 0x60A9 says (nullopt: none), fitted to its EDS; empty, else why not.
-  std::string make_drive_steps(Winch& winch, std::optional<std::uint32_t> si_unit_velocity,
+  // The drive's steps for the units its unit objects say (drive_units.h), fitted to its EDS; empty, else why not.
+  std::string make_drive_steps(Winch& winch, const DriveUnitObjects& unit_objects,
                                std::optional<std::uint32_t> max_motor_speed);
+  // The unit objects from `value` (index, subindex -> the probe's or the EDS's value, nullopt where absent).
+  static DriveUnitObjects unit_objects(
+      const std::function<std::optional<std::uint32_t>(std::uint16_t, std::uint8_t)>& value);
   void load_eds(Node& node, const std::string& path, std::map<std::string, std::shared_ptr<const Eds>>& loaded);
   // Loads the EDS files and fits the steps to them; a misfit goes to setup_error_.
   void fit_to_devices();

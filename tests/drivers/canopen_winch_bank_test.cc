@@ -737,17 +737,27 @@ TEST_F(CanopenWinchBankTest, EveryShippedVirtualDeviceEdsBuildsADeviceTheMasterC
     const char* drive_eds;
     const char* encoder_eds;
   };
+  // (and the real devices' files, played from disk: consistent with what the daemon needs, not with the device)
   for (const Case c : {Case{"cdpr-virtual-drive.eds", "cdpr-virtual-encoder.eds"},
                        Case{"cdpr-virtual-drive-rtr-bit30.eds", "cdpr-virtual-encoder.eds"},
                        Case{"cdpr-virtual-drive-no-type-255.eds", "cdpr-virtual-encoder.eds"},
                        Case{"cdpr-virtual-drive-rpm.eds", "cdpr-virtual-encoder.eds"},
-                       Case{"cdpr-virtual-drive.eds", "cdpr-virtual-encoder-two-tpdo.eds"}}) {
+                       Case{"cdpr-virtual-drive.eds", "cdpr-virtual-encoder-two-tpdo.eds"},
+                       Case{"maxon-epos4.eds", "kuebler-sendix.eds"}}) {
     SCOPED_TRACE(std::string(c.drive_eds) + " + " + c.encoder_eds);
+    const bool real = std::string(c.drive_eds) == "maxon-epos4.eds";
+    const auto played = [real](const char* name) {
+      std::string error;
+      return real ? virtual_robot::read_device_eds(std::string(CDPR_SOURCE_DIR) + "/systemd/eds/" + name, error)
+                  : virtual_robot::shipped_eds(name);
+    };
     virtual_robot::DriveDefaults drive = rpm_drive();
-    drive.eds = virtual_robot::shipped_eds(c.drive_eds);
+    drive.eds = played(c.drive_eds);
     drive.stored.clear();
     virtual_robot::EncoderDefaults encoder;
-    encoder.eds = virtual_robot::shipped_eds(c.encoder_eds);
+    encoder.eds = played(c.encoder_eds);
+    ASSERT_EQ(virtual_robot::Cia402Device::check(1, drive), "");
+    ASSERT_EQ(virtual_robot::Cia406Device::check(11, encoder), "");
     CanWinchBankConfig config = rpm_winches();
     config.drive.profile_velocity_mps = 1.0;  // 9549 rpm: below the rpm drive's 0x6080 of 10000
     config.drive.eds = std::string(CDPR_SOURCE_DIR) + "/systemd/eds/" + c.drive_eds;
@@ -796,6 +806,70 @@ TEST_F(CanopenWinchBankTest, AWinchWhoseDriveDiffersIsConfiguredFromItsOwnEds) {
   ASSERT_TRUE(bank_->set_target_payouts(to_m).ok());
   run_ms(1000);
   for (int i = 0; i < 2; ++i) EXPECT_NEAR(bank_->status(i).payout_m, to_m[i], kEncoderMPerCount) << "winch " << i;
+}
+
+// The shipped virtual drive's EDS with `sections` added (objects of the factor group).
+virtual_robot::DriveDefaults drive_with(const std::string& sections) {
+  virtual_robot::DriveDefaults drive;
+  drive.eds.text += "\n" + sections;
+  return drive;
+}
+
+std::string factor_group(const char* index, const char* name, int numerator, int divisor) {
+  std::string text = std::string("[") + index + "]\nParameterName=" + name + "\nObjectType=0x8\nSubNumber=3\n\n";
+  text += std::string("[") + index + "sub0]\nDataType=0x0005\nAccessType=ro\nDefaultValue=2\n\n";
+  text += std::string("[") + index + "sub1]\nDataType=0x0007\nAccessType=rw\nDefaultValue=" + std::to_string(numerator) + "\n\n";
+  text += std::string("[") + index + "sub2]\nDataType=0x0007\nAccessType=rw\nDefaultValue=" + std::to_string(divisor) + "\n\n";
+  return text;
+}
+
+TEST_F(CanopenWinchBankTest, DriveWithAVelocityAndAccelerationFactorGetsItsProfileDividedByThem) {
+  // GIVEN drives with a velocity factor 0x6096 = 2/1 and an acceleration factor 0x6097 = 4/1 (no EDS given)
+  start(two_winches(), drive_with(factor_group("6096", "Velocity factor", 2, 1) +
+                                  factor_group("6097", "Acceleration factor", 4, 1)));
+  // WHEN configured THEN 4 m/s (20000 counts/s) is written as 10000 and 40 m/s^2 (200000 counts/s^2) as 50000
+  open_and_configure();
+  EXPECT_EQ(bus_->drive(0).od().get(0x6081, 0), 10000u);
+  EXPECT_EQ(bus_->drive(0).od().get(0x6083, 0), 50000u);
+  EXPECT_EQ(bus_->drive(0).od().get(0x6085, 0), 50000u);
+  // AND a move of 0.8 m runs the profile the configuration asks: at 4 m/s and 40 m/s^2 it takes 0.3 s
+  ASSERT_TRUE(bank_->enable().ok());
+  run_ms(100);
+  const double to_m[2] = {bank_->status(0).payout_m + 0.8, bank_->status(1).payout_m + 0.4};
+  ASSERT_TRUE(bank_->set_target_payouts(to_m).ok());
+  run_ms(450);  // the profile SDO writes, the set-point handshake and 0.3 s of motion
+  for (int i = 0; i < 2; ++i) EXPECT_NEAR(bank_->status(i).payout_m, to_m[i], kEncoderMPerCount) << "winch " << i;
+  EXPECT_TRUE(bank_->motion_finished());
+}
+
+TEST_F(CanopenWinchBankTest, GearRatioWithRpmIsAStartErrorNamingNodeObjectAndValue) {
+  // GIVEN rpm drives whose EDS has a gear ratio 0x6091 of 10 / 1, given to the daemon
+  virtual_robot::DriveDefaults drive = rpm_drive();
+  drive.eds.text += "\n" + factor_group("6091", "Gear ratio", 10, 1);
+  drive.eds.name = ::testing::TempDir() + "geared-rpm.eds";
+  {
+    std::FILE* f = std::fopen(drive.eds.name.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fputs(drive.eds.text.c_str(), f);
+    std::fclose(f);
+  }
+  CanWinchBankConfig config = rpm_winches();
+  config.drive.eds = drive.eds.name;
+  start(config, drive);
+  // THEN refused at start, before anything is written, naming node, object and value
+  EXPECT_EQ(bank_->setup_error(),
+            "node 1: 0x6091 (gear ratio) = 10 / 1 with velocities in rpm: whose revolutions those are is the "
+            "drive's reading; set it to 1 / 1 and the gear in [winches.mechanics] gear_ratio");
+  EXPECT_FALSE(bank_->open().ok());
+  // AND without the EDS the same drive is refused when its probe reads 0x6091, as a latched fault
+  config.drive.eds.clear();
+  start(config, drive);
+  ASSERT_TRUE(bank_->open().ok());
+  run_ms(300);
+  EXPECT_TRUE(bank_->status(0).fault);
+  EXPECT_NE(bank_->fault_text(0).find("node 1: 0x6091 (gear ratio) = 10 / 1"), std::string::npos)
+      << bank_->fault_text(0);
+  EXPECT_EQ(bus_->drive(0).od().get(0x1800, 5), 0u);  // nothing configured after the probe
 }
 
 TEST_F(CanopenWinchBankTest, EncoderDescribedByItsEdsIsNotAskedForPdosItLacks) {

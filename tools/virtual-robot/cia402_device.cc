@@ -269,7 +269,12 @@ void Cia402Device::take_setpoint(hal::TimeUs now_us) {
 }
 
 double Cia402Device::counts_per_s(std::uint16_t index) const {
-  const double value = od().get(index, 0);
+  double value = od().get(index, 0);
+  // The factor group where the EDS has it: internal = written x numerator / divisor.
+  const std::uint16_t factor = index == 0x6081 ? 0x6096 : 0x6097;
+  const OdEntry* numerator = od().find(factor, 1);
+  const OdEntry* divisor = od().find(factor, 2);
+  if (numerator != nullptr && divisor != nullptr && divisor->value != 0) value = value * numerator->value / divisor->value;
   return rpm_units_ ? value * defaults_.counts_per_rev / 60.0 : value;
 }
 

@@ -29,7 +29,9 @@
 //   1), or rpm (0x00B44700) as maxon EPOS4, Nanotec and Synapticon drives
 //   come: profile velocity 0x6081 in rpm, 0x6083/0x6084/0x6085 in rpm/s,
 //   max motor speed 0x6080 in rpm (a faster 0x6081 is refused), and
-//   counts_per_rev motor position counts per revolution.
+//   counts_per_rev motor position counts per revolution; a velocity
+//   factor 0x6096 and an acceleration factor 0x6097 where its EDS has them
+//   (internal = written x numerator / divisor);
 // Its objects, their power-on values (the shipped cdpr-virtual-drive.eds:
 // the CiA 402 predefined PDOs, RPDO1 = controlword only, TPDO1 = statusword
 // only, the others invalid), PDO count and ranges come from its EDS.
