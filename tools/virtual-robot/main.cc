@@ -34,7 +34,8 @@ int main(int argc, char** argv) {
   app.add_option("--time-scale", options.time_scale, "simulated seconds per real second (drive speed, settling)")
       ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--endpoints,--dir", options.dir,
-                 "directory for can.sock, pose.sock, clock (the robot's clock: cdpr-calibd --sim-clock), robot.toml, truth.toml and ready (created)")->required();
+                 "directory for can.sock, pose.sock, clock (the robot's clock: cdpr-calibd --sim-clock), robot.toml, truth.toml, "
+                 "drive.eds and encoder.eds (what its CANopen nodes play) and ready (created)")->required();
   app.add_option("--modbus-port", options.modbus_port, "Modbus TCP port on 127.0.0.1; 0: any free port (see ready)")
       ->check(CLI::Range(0, 65535))->capture_default_str();
   std::string transport = "tcp";

@@ -94,10 +94,13 @@ Expected<std::unique_ptr<VirtualRobot>, std::string> VirtualRobot::create(const 
   }
   robot->publish(now_us);
 
+  // drive.eds, encoder.eds: the EDS files its nodes play, for the daemon's [winches.drive|encoder] eds.
   if (!write_file(options.dir + "/robot.toml", formats::format_robot_toml(robot->data_.nominal)) ||
       !write_file(options.dir + "/truth.toml", formats::format_truth_toml(robot->data_.truth)) ||
+      !write_file(options.dir + "/drive.eds", options.nodes.drive_eds.text) ||
+      !write_file(options.dir + "/encoder.eds", options.nodes.encoder_eds.text) ||
       !write_file(options.dir + "/ready", ready)) {
-    return Unexpected{"cannot write robot.toml, truth.toml or ready in " + options.dir};
+    return Unexpected{"cannot write robot.toml, truth.toml, the EDS files or ready in " + options.dir};
   }
   return robot;
 }
