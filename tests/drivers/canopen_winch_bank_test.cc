@@ -967,6 +967,40 @@ TEST_F(CanopenWinchBankTest, PayoutPastHalfTheEncoderRangeReadsTheSameAfterARest
   EXPECT_NEAR(bank_->status(0).payout_m, payout_m, 1e-9);
 }
 
+TEST_F(CanopenWinchBankTest, PayoutPastHalfTheRangeFromItsStartReadsTheSameAfterARestartFromTheKeptPosition) {
+  // GIVEN encoders with a 100000-count measuring range (10 m at 0.1 mm), winch 0's at raw 45000,
+  // no payout range, and the positions kept in a file
+  virtual_robot::EncoderDefaults encoder;
+  encoder.stored[virtual_robot::object_key(0x6002, 0)] = 100'000;
+  CanWinchBankConfig config = two_winches();
+  config.last_positions_path = ::testing::TempDir() + "winch-positions-" + std::to_string(::getpid());
+  std::remove(config.last_positions_path.c_str());
+  start(config, {}, encoder);
+  bus_->winch(0).encoder_offset = 45'000;
+  open_and_configure();
+  ASSERT_NEAR(bank_->status(0).payout_m, 4.5, 1e-9);
+  // WHEN the cable pays out past half the range from zero (to raw 65000, at 8 m/s) and the daemon restarts
+  for (int step = 0; step < 50; ++step) {
+    bus_->winch(0).encoder_offset += 400;
+    run_ms(5);
+  }
+  ASSERT_NEAR(bank_->status(0).payout_m, 6.5, 1e-9) << bank_->fault_text(0);
+  bank_->close();
+  start(config, {}, encoder);
+  bus_->winch(0).encoder_offset = 65'000;
+  open_and_configure();
+  // THEN it reads 6.5 m, not a whole range (10 m) less
+  EXPECT_NEAR(bank_->status(0).payout_m, 6.5, 1e-9);
+  // AND without the kept position (as before) the first reading is taken nearest zero: -3.5 m
+  bank_->close();
+  config.last_positions_path.clear();
+  start(config, {}, encoder);
+  bus_->winch(0).encoder_offset = 65'000;
+  open_and_configure();
+  EXPECT_NEAR(bank_->status(0).payout_m, -3.5, 1e-9);
+  std::remove((::testing::TempDir() + "winch-positions-" + std::to_string(::getpid())).c_str());
+}
+
 TEST(CanopenWinchBankConfig, RejectsSharedNodeIdsAndZeroScales) {
   CanWinchBankConfig config;
   config.winches = {{1, 11, 1e-4, 1e-4}, {2, 11, 1e-4, 1e-4}};
