@@ -119,10 +119,12 @@ fuzz: deps
 	./tests/fuzz/run_fuzzers.sh $(FUZZ_BUILD) $(FUZZ_SECONDS) $(subst $(comma), ,$(FUZZ_TARGETS))
 
 # The daemon against the virtual robot over real sockets, button via calibctl.
-# Builds those three programs only.
+# Builds those three programs only. QUIRKS=rpm-units (or two-tpdo-encoder,
+# rtr-bit30, no-type-255): the robot's CANopen nodes play that vendor quirk.
+QUIRKS ?= none
 demo: configure
 	cmake --build $(BUILD) -j $(JOBS) --target cdpr-calibd virtual-robot calibctl
-	./tools/demo.sh $(BUILD)
+	DEMO_QUIRKS=$(QUIRKS) ./tools/demo.sh $(BUILD)
 
 # The offline pipeline only: cdpr-sim, cdpr-calib solve, compare with truth.
 demo-offline: configure

@@ -124,7 +124,8 @@ int main(int argc, char** argv) {
     log_line("configuration: " + problem->message());
     return 1;
   }
-  const drivers::can::CanWinchBankConfig& winch_config = config->winches;
+  drivers::can::CanWinchBankConfig winch_config = config->winches;
+  winch_config.last_positions_path = config->store.state_dir + "/winch-positions";  // survives a restart
   const drivers::modbus::ModbusLoadCellConfig& cell_config = config->load_cell;
   for (const std::string& problem : {drivers::can::validate(winch_config), drivers::modbus::validate(cell_config)}) {
     if (!problem.empty()) {

@@ -17,6 +17,11 @@
 # daemon's history (each run's samples, log and model check) to DIR/history.
 # DEMO_EFFECTS adds virtual-robot options, e.g. a hidden effect such as
 # "--force-bias 15" or "--axial-stiffness 1.5e6" (virtual-robot --help).
+# DEMO_QUIRKS (make demo QUIRKS=...) has the robot's CANopen nodes play a
+# vendor quirk profile: two-tpdo-encoder, rtr-bit30, no-type-255 or
+# rpm-units (docs/fieldbus.md, "Vendor quirks"); the daemon is given the
+# EDS files the nodes play (the robot writes them beside robot.toml) and
+# the virtual winch's mechanics (0.2 m drum, gear 10).
 set -euo pipefail
 build=$(cd "${1:-build}" && pwd)
 work=$(mktemp -d /tmp/cdpr-demo.XXXXXX)
@@ -39,7 +44,9 @@ trap 'exit 130' INT TERM
 start=$(date +%s)
 echo "== virtual robot: large preset (240 x 220 x 50 m, 34 kg platform), physics 20x real time,"
 echo "   nominal anchors in robot.toml 0.3 m off the truth, encoder offsets unknown"
-start_virtual_robot "$work" "$build" 20 "${DEMO_SEED:-7}" ${DEMO_EFFECTS:-}
+quirks=${DEMO_QUIRKS:-none}
+[[ $quirks != none ]] && echo "   CANopen nodes playing the vendor quirk profile $quirks"
+start_virtual_robot "$work" "$build" 20 "${DEMO_SEED:-7}" --canopen-quirks "$quirks" ${DEMO_EFFECTS:-}
 
 # The physics runs 20x faster: a 2 m/s cable pays out 40 m per real second.
 # The virtual robot's CANopen nodes and pose stream share one thread with its
@@ -54,7 +61,11 @@ write_daemon_config "$work" \
   winches="max_speed_mps = 100.0
 heartbeat_timeout_ms = 2000" \
   limits="settle_timeout_s = 15.0
-pose_stale_ms = 2000"
+pose_stale_ms = 2000" \
+  drive="eds = \"$work/robot/drive.eds\"" \
+  encoder="eds = \"$work/robot/encoder.eds\"" \
+  mechanics="drum_diameter_m = 0.2
+gear_ratio = 10.0"
 
 echo "== cdpr-calibd (foreground, state in $work/state)"
 "$build/src/cdpr-calibd" --config "$work/cdpr-calibd.toml" --sim-clock "$work/robot/clock" 2>"$work/daemon.log" &

@@ -40,8 +40,9 @@ start_virtual_robot() {
 # Writes $1/cdpr-calibd.toml: the daemon against the robot start_virtual_robot
 # started in $1, state in $1/state, control socket $1/control. Each further
 # argument SECTION=LINES adds TOML lines to that section ("top" is the top
-# level, before the first table; "drive" is
-# [winches.drive]); the keys are those of systemd/cdpr-calibd.toml.
+# level, before the first table; "drive", "encoder", "mechanics" are
+# [winches.drive], [winches.encoder], [winches.mechanics]); the keys are
+# those of systemd/cdpr-calibd.toml.
 #   write_daemon_config WORK [winches=...] [load_cell=...] [limits=...] ...
 write_daemon_config() {
   local work=$1
@@ -62,6 +63,10 @@ endpoint = "unix:$work/robot/can.sock"
 ${keys[winches]:-}
 [winches.drive]
 ${keys[drive]:-}
+[winches.encoder]
+${keys[encoder]:-}
+[winches.mechanics]
+${keys[mechanics]:-}
 [load_cell]
 # The virtual FT-11 shows kilograms with two decimals.
 endpoint = "rtu:$work/robot/load_cell.tty"

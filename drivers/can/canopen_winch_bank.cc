@@ -122,6 +122,12 @@ CanopenWinchBank::CanopenWinchBank(CanWinchBankConfig config, CanConnector conne
     winches_.push_back(std::move(w));
   }
   for (Winch& w : winches_) w.encoder.set_centre(payout_centre_counts(w));
+  if (!config_.last_positions_path.empty()) {
+    kept_counts_ = read_last_positions(config_.last_positions_path, winches_.size());
+    for (std::size_t i = 0; i < winches_.size(); ++i) {
+      if (kept_counts_[i]) winches_[i].encoder.set_centre(*kept_counts_[i]);
+    }
+  }
   fit_to_devices();
 }
 
@@ -161,7 +167,34 @@ hal::Status CanopenWinchBank::open() {
   return send_master_heartbeat(now_us_);
 }
 
-void CanopenWinchBank::close() { transport_.reset(); }
+void CanopenWinchBank::close() {
+  if (transport_) keep_positions(true);
+  transport_.reset();
+}
+
+void CanopenWinchBank::keep_positions(bool always) {
+  if (config_.last_positions_path.empty()) return;
+  kept_counts_.resize(winches_.size());
+  bool moved = false;
+  std::vector<std::optional<std::int64_t>> counts = kept_counts_;
+  for (std::size_t i = 0; i < winches_.size(); ++i) {
+    const Winch& w = winches_[i];
+    if (w.encoder_node.id == 0 || !w.encoder.valid()) continue;
+    counts[i] = w.encoder.counts();
+    const auto eighth = static_cast<std::int64_t>(w.encoder.range() / 8);
+    moved = moved || !kept_counts_[i] || std::llabs(*counts[i] - *kept_counts_[i]) > eighth || (always && counts[i] != kept_counts_[i]);
+  }
+  if (!moved) return;
+  std::string error;
+  if (!write_last_positions(config_.last_positions_path, counts, error)) {
+    ++counters_.errors;  // kept again at the next eighth; the payout range's centre stays the fallback
+    return;
+  }
+  kept_counts_ = counts;
+  for (std::size_t i = 0; i < winches_.size(); ++i) {
+    if (kept_counts_[i]) winches_[i].encoder.set_centre(*kept_counts_[i]);
+  }
+}
 
 hal::Status CanopenWinchBank::send(const CanFrame& frame) {
   if (hal::Status s = check_open(); !s.ok()) return s;
@@ -200,6 +233,7 @@ hal::Status CanopenWinchBank::update(hal::TimeUs now_us) {
   }
   if (hal::Status s = service_coordinated_move(now_us); !s.ok() && first_error.ok()) first_error = s;
   if (hal::Status s = poll_drives(now_us); !s.ok() && first_error.ok()) first_error = s;
+  keep_positions(false);
   return first_error;
 }
 

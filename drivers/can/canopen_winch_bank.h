@@ -28,9 +28,9 @@
 // Units: payout [m] = encoder counts x encoder_m_per_count, the encoder's
 // UNSIGNED32 position unwrapped across its measuring range
 // (encoder_unwrap.h; a jump faster than max_speed_mps is a latched fault;
-// the first reading after a (re)start is taken nearest the middle of
-// min/max_payout_m, so a payout range within one measuring range reads
-// the same after every restart).
+// the first reading after a (re)start is taken nearest the position kept
+// in last_positions_path, else nearest the middle of min/max_payout_m, so a
+// cable anywhere in the measuring range reads the same after a restart).
 // Targets go to the drive relative to the present: target_counts =
 // actual_counts + round((target_m - payout_m) / drive_m_per_count), so
 // motor and cable encoder need not share a zero; |target_m - payout_m| <=
@@ -56,6 +56,7 @@
 #include "drivers/can/device_configuration.h"
 #include "drivers/can/eds.h"
 #include "drivers/can/encoder_unwrap.h"
+#include "drivers/can/last_positions.h"
 #include "drivers/can/node_configurator.h"
 #include "hal/winch_bank.h"
 
@@ -66,6 +67,10 @@ struct CanWinchConfig {
   int encoder_node_id = 0;           // 1..127, != drive; 0: no encoder node, use the drive's position
   double encoder_m_per_count = 0.0;  // payout [m] per encoder count, sign gives direction; != 0
   double drive_m_per_count = 0.0;    // payout [m] per drive position count; != 0
+  // This winch's drive's and encoder's EDS where they differ from the
+  // others' (a replaced or another make of device); empty: DriveDescription::eds / EncoderDescription::eds.
+  std::string drive_eds = {};
+  std::string encoder_eds = {};
 };
 
 // The winch between motor and cable, for drives that count motor
@@ -99,6 +104,13 @@ struct CanWinchBankConfig {
   double min_payout_m = -std::numeric_limits<double>::infinity();
   double max_payout_m = std::numeric_limits<double>::infinity();
   double position_limit_margin_m = 0.5;
+  // Where each encoder's last unwrapped position is kept (last_positions.h;
+  // the daemon: <state_dir>/winch-positions); empty: not kept. Written
+  // whenever a winch's position moved an eighth of its measuring range
+  // from the one kept, and at close(); read at construction: a first
+  // reading after a (re)start is taken nearest it, not nearest the middle
+  // of min/max_payout_m.
+  std::string last_positions_path;
   DriveDescription drive;
   EncoderDescription encoder;
   WinchMechanics mechanics;
@@ -206,9 +218,12 @@ class CanopenWinchBank final : public hal::WinchBank {
   hal::Status service_node(Winch& winch, Node& node, hal::TimeUs now_us);
   // The probe's answers made into `node.steps`; empty, else why the node cannot be configured.
   std::string configure_from_probe(Winch& winch, Node& node);
-  // The drive's steps for the units its 0x60A9 says (nullopt: none), fitted to its EDS; empty, else why not.
-  std::string make_drive_steps(Winch& winch, std::optional<std::uint32_t> si_unit_velocity,
+  // The drive's steps for the units its unit objects say (drive_units.h), fitted to its EDS; empty, else why not.
+  std::string make_drive_steps(Winch& winch, const DriveUnitObjects& unit_objects,
                                std::optional<std::uint32_t> max_motor_speed);
+  // The unit objects from `value` (index, subindex -> the probe's or the EDS's value, nullopt where absent).
+  static DriveUnitObjects unit_objects(
+      const std::function<std::optional<std::uint32_t>(std::uint16_t, std::uint8_t)>& value);
   void load_eds(Node& node, const std::string& path, std::map<std::string, std::shared_ptr<const Eds>>& loaded);
   // Loads the EDS files and fits the steps to them; a misfit goes to setup_error_.
   void fit_to_devices();
@@ -217,6 +232,9 @@ class CanopenWinchBank final : public hal::WinchBank {
   std::vector<SdoStep> enable_steps(const Winch& winch) const;
   // The middle of min/max_payout_m in position counts: where a first reading is unwrapped to.
   std::int64_t payout_centre_counts(const Winch& winch) const;
+  // Keeps the encoders' positions (config_.last_positions_path) when one moved
+  // an eighth of its range from the one kept, or with `always`.
+  void keep_positions(bool always);
   hal::Status service_coordinated_move(hal::TimeUs now_us);
   // Reads 0x603F of a drive that entered fault (what EMCY may have missed).
   hal::Status service_error_code(Winch& winch, hal::TimeUs now_us);
@@ -234,6 +252,7 @@ class CanopenWinchBank final : public hal::WinchBank {
 
   CanWinchBankConfig config_;
   CanConnector connector_;
+  std::vector<std::optional<std::int64_t>> kept_counts_;  // per winch, as last written
   std::string setup_error_;
   std::unique_ptr<CanTransport> transport_;
   std::vector<Winch> winches_;

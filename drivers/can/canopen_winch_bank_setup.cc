@@ -27,20 +27,23 @@ void CanopenWinchBank::fit_to_devices() {
   for (std::size_t i = 0; i < winches_.size() && setup_error_.empty(); ++i) {
     Winch& w = winches_[i];
     const CanWinchConfig& c = config_.winches[i];
-    load_eds(w.drive_node, config_.drive.eds, loaded);
-    if (c.encoder_node_id != 0) load_eds(w.encoder_node, config_.encoder.eds, loaded);
+    load_eds(w.drive_node, c.drive_eds.empty() ? config_.drive.eds : c.drive_eds, loaded);
+    if (c.encoder_node_id != 0) load_eds(w.encoder_node, c.encoder_eds.empty() ? config_.encoder.eds : c.encoder_eds, loaded);
     if (!setup_error_.empty()) break;
     std::string why;
     if (w.drive_node.eds) {
       why = fit_to_eds(*w.drive_node.eds, w.drive_node.probe_steps);
       // The units the EDS gives by default: a drive the configuration cannot fit is refused now, not at its first boot.
-      const EdsEntry* units = w.drive_node.eds->find(0x60A9, 0);
-      const EdsEntry* max_speed = w.drive_node.eds->find(0x6080, 0);
-      const auto value = [](const EdsEntry* e) -> std::optional<std::uint32_t> {
+      const Eds& eds = *w.drive_node.eds;
+      const auto value = [&eds](std::uint16_t index, std::uint8_t subindex) -> std::optional<std::uint32_t> {
+        const EdsEntry* e = eds.find(index, subindex);
         if (e == nullptr || !e->default_value) return std::nullopt;
         return static_cast<std::uint32_t>(*e->default_value);
       };
-      if (why.empty() && (units == nullptr || units->default_value)) why = make_drive_steps(w, value(units), value(max_speed));
+      const EdsEntry* units = eds.find(0x60A9, 0);
+      if (why.empty() && (units == nullptr || units->default_value)) {
+        why = make_drive_steps(w, unit_objects(value), value(0x6080, 0));
+      }
       if (!why.empty()) setup_error_ = "node " + std::to_string(c.drive_node_id) + ": " + why;
     }
     if (setup_error_.empty() && w.encoder_node.eds) {
@@ -79,18 +82,33 @@ std::string CanopenWinchBank::nodes_without_eds() const {
   return text;
 }
 
-std::string CanopenWinchBank::configure_from_probe(Winch& w, Node& node) {
-  const NodeConfigurator& probe = node.configurator;
-  return make_drive_steps(w, probe.read_value(0x60A9, 0), probe.read_value(0x6080, 0));
+DriveUnitObjects CanopenWinchBank::unit_objects(
+    const std::function<std::optional<std::uint32_t>(std::uint16_t, std::uint8_t)>& value) {
+  DriveUnitObjects o;
+  o.si_unit_velocity = value(0x60A9, 0);
+  o.si_unit_acceleration = value(0x60AA, 0);
+  o.gear_motor_revs = value(0x6091, 1);
+  o.gear_shaft_revs = value(0x6091, 2);
+  o.velocity_numerator = value(0x6096, 1);
+  o.velocity_divisor = value(0x6096, 2);
+  o.acceleration_numerator = value(0x6097, 1);
+  o.acceleration_divisor = value(0x6097, 2);
+  return o;
 }
 
-std::string CanopenWinchBank::make_drive_steps(Winch& w, std::optional<std::uint32_t> si_unit_velocity,
+std::string CanopenWinchBank::configure_from_probe(Winch& w, Node& node) {
+  const NodeConfigurator& probe = node.configurator;
+  const auto value = [&probe](std::uint16_t index, std::uint8_t subindex) { return probe.read_value(index, subindex); };
+  return make_drive_steps(w, unit_objects(value), probe.read_value(0x6080, 0));
+}
+
+std::string CanopenWinchBank::make_drive_steps(Winch& w, const DriveUnitObjects& unit_objects,
                                                std::optional<std::uint32_t> max_motor_speed) {
   const std::size_t i = static_cast<std::size_t>(&w - winches_.data());
   const CanWinchConfig& c = config_.winches[i];
   std::string why;
   const std::optional<DriveUnits> units =
-      drive_units(si_unit_velocity, c.drive_m_per_count, config_.mechanics.m_per_motor_rev(), why);
+      drive_units(unit_objects, c.drive_m_per_count, config_.mechanics.m_per_motor_rev(), why);
   if (!units) return why;
   const std::uint32_t velocity = drive_value(*units, config_.drive.profile_velocity_mps);
   if (max_motor_speed && velocity > *max_motor_speed) {

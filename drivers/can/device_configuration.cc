@@ -111,6 +111,17 @@ std::vector<SdoStep> drive_probe(const DriveDescription& d) {
   max_speed.optional = true;
   steps.push_back(units);
   steps.push_back(max_speed);
+  // The rest of the unit objects (drive_units.h), each where the drive has it.
+  for (const SdoStep& s : {SdoStep{Kind::kRead, 0x60AA, 0, 4, 0, "SI unit acceleration"},
+                           SdoStep{Kind::kRead, 0x6091, 1, 4, 0, "gear ratio motor revolutions"},
+                           SdoStep{Kind::kRead, 0x6091, 2, 4, 0, "gear ratio shaft revolutions"},
+                           SdoStep{Kind::kRead, 0x6096, 1, 4, 0, "velocity factor numerator"},
+                           SdoStep{Kind::kRead, 0x6096, 2, 4, 0, "velocity factor divisor"},
+                           SdoStep{Kind::kRead, 0x6097, 1, 4, 0, "acceleration factor numerator"},
+                           SdoStep{Kind::kRead, 0x6097, 2, 4, 0, "acceleration factor divisor"}}) {
+    steps.push_back(s);
+    steps.back().optional = true;
+  }
   return steps;
 }
 
@@ -131,9 +142,11 @@ std::vector<SdoStep> drive_configuration(int node_id, int master_node_id, double
   steps.push_back({Kind::kWriteVerify, 0x607D, 2, 4, static_cast<std::uint32_t>(d.position_limit_max_counts),
                    "software position limit max"});
   steps.push_back({Kind::kWriteVerify, 0x6081, 0, 4, drive_value(units, d.profile_velocity_mps), "profile velocity"});
-  steps.push_back({Kind::kWriteVerify, 0x6083, 0, 4, drive_value(units, d.profile_acceleration_mps2), "profile acceleration"});
-  steps.push_back({Kind::kWriteVerify, 0x6084, 0, 4, drive_value(units, d.profile_deceleration_mps2), "profile deceleration"});
-  steps.push_back({Kind::kWriteVerify, 0x6085, 0, 4, drive_value(units, d.quick_stop_deceleration_mps2),
+  steps.push_back(
+      {Kind::kWriteVerify, 0x6083, 0, 4, drive_acceleration(units, d.profile_acceleration_mps2), "profile acceleration"});
+  steps.push_back(
+      {Kind::kWriteVerify, 0x6084, 0, 4, drive_acceleration(units, d.profile_deceleration_mps2), "profile deceleration"});
+  steps.push_back({Kind::kWriteVerify, 0x6085, 0, 4, drive_acceleration(units, d.quick_stop_deceleration_mps2),
                    "quick stop deceleration"});
   steps.push_back({Kind::kWriteVerify, 0x1017, 0, 2, milliseconds(d.heartbeat_producer_us), "producer heartbeat time"});
   steps.push_back({Kind::kWriteVerify, 0x1016, 1, 4,

@@ -1,5 +1,6 @@
 #include "src/daemon/device_config_tables.h"
 
+#include "drivers/can/eds.h"
 #include "drivers/modbus/load_cell_presets.h"
 
 namespace cdpr::daemon {
@@ -27,6 +28,14 @@ void identity_rows(Table<Description>& t) {
       .why("UNSIGNED32 object");
   t.integer("product_code", &Description::product_code, 0, kUnsigned32, "", "0x1018:02 expected; 0: not checked")
       .why("UNSIGNED32 object");
+}
+
+// An EDS key's check: empty, or a file libinih reads as an EDS (read once more at start).
+constexpr const char* kEdsRange = "empty, or a readable EDS/DCF file";
+std::string eds_problem(const std::string& path) {
+  if (path.empty()) return "";
+  std::string error;
+  return drivers::can::Eds::load(path, error) ? "" : error;
 }
 
 }  // namespace
@@ -74,7 +83,8 @@ Table<DriveDescription> drive_table() {
   identity_rows(t);
   t.string("eds", &DriveDescription::eds, "",
            "the drives' EDS/DCF file (CiA 306; e.g. /usr/share/cdpr-calibration/eds/maxon-epos4.eds): only objects it "
-           "lists are configured, within their access type and range; empty: CiA 402 defaults assumed");
+           "lists are configured, within their access type and range; empty: CiA 402 defaults assumed")
+      .refusing(kEdsRange, [](const DriveDescription& d) { return eds_problem(d.eds); });
   t.integer("quick_stop_option", &DriveDescription::quick_stop_option, 6, {0, 6}, "",
             "0x605A: 0, 1, 2 (end switched off) or 5, 6 (stay in quick stop)")
       .why("3 and 4 stop at a current or voltage limit, not on a ramp")
@@ -127,7 +137,8 @@ Table<EncoderDescription> encoder_table() {
   identity_rows(t);
   t.string("eds", &EncoderDescription::eds, "",
            "the encoders' EDS/DCF file (e.g. /usr/share/cdpr-calibration/eds/kuebler-sendix.eds); empty: CiA 406 "
-           "defaults assumed");
+           "defaults assumed")
+      .refusing(kEdsRange, [](const EncoderDescription& d) { return eds_problem(d.eds); });
   t.duration("heartbeat_producer_ms", &EncoderDescription::heartbeat_producer_us, 100, kMs, {10, 1000, true},
              "0x1017 of the encoder")
       .why("UNSIGNED16 whole ms; winches.heartbeat_timeout_ms must be >= 1.5 x this");
@@ -172,6 +183,13 @@ Table<CanWinchConfig> winch_table() {
   t.number("drive_m_per_count", &CanWinchConfig::drive_m_per_count, 1e-5, kMetresPerCount, "m",
            "payout per drive position count")
       .why("a count of more than 1 cm is no drive encoder; 0 would make every target 0");
+  t.string("drive_eds", &CanWinchConfig::drive_eds, "",
+           "this winch's drive's EDS/DCF where it differs from winches.drive.eds (another make, a replacement); "
+           "empty: that one")
+      .refusing(kEdsRange, [](const CanWinchConfig& c) { return eds_problem(c.drive_eds); });
+  t.string("encoder_eds", &CanWinchConfig::encoder_eds, "",
+           "this winch's encoder's EDS/DCF where it differs from winches.encoder.eds; empty: that one")
+      .refusing(kEdsRange, [](const CanWinchConfig& c) { return eds_problem(c.encoder_eds); });
   return t;
 }
 

@@ -259,7 +259,7 @@ TEST_F(CanopenWinchBankTest, HeartbeatLossStopsEveryWinchAlongTheCommandedLine) 
 TEST_F(CanopenWinchBankTest, DriveLeftInHomingModeIsSwitchedToProfilePosition) {
   // GIVEN drives that power on in homing mode (0x6060 = 6)
   virtual_robot::DriveDefaults homing;
-  homing.power_on_mode = 6;
+  homing.stored[virtual_robot::object_key(0x6060, 0)] = 6;
   start(two_winches(), homing);
   // WHEN enabled and sent 0.2 m
   open_and_enable();
@@ -276,7 +276,7 @@ TEST_F(CanopenWinchBankTest, DriveThatSwitchesModeLateIsEnabledOnceItShowsTheMod
   // GIVEN drives in homing mode that show a new mode in 0x6061 only 150 ms
   // after 0x6060 is written (drives switch asynchronously)
   virtual_robot::DriveDefaults homing;
-  homing.power_on_mode = 6;
+  homing.stored[virtual_robot::object_key(0x6060, 0)] = 6;
   start(two_winches(), homing);
   bus_->set_mode_switch_delay(150'000);
   // WHEN enabled
@@ -299,7 +299,7 @@ TEST_F(CanopenWinchBankTest, DriveThatNeverShowsTheModeIsRefusedAfterTheTimeout)
   CanWinchBankConfig config = two_winches();
   config.mode_switch_timeout_us = 200'000;
   virtual_robot::DriveDefaults homing;
-  homing.power_on_mode = 6;
+  homing.stored[virtual_robot::object_key(0x6060, 0)] = 6;
   start(config, homing);
   bus_->set_mode_switch_delay(10'000'000);
   // WHEN enabled
@@ -346,9 +346,10 @@ TEST_F(CanopenWinchBankTest, RefusedWriteNamesTheAbortCode) {
   start(config);
   ASSERT_TRUE(bank_->open().ok());
   run_ms(500);
-  // THEN the configuration stops there with the device's abort code
+  // THEN the configuration stops there with the device's abort code (its EDS says LowLimit=1)
   EXPECT_TRUE(bank_->status(0).fault);
-  EXPECT_NE(bank_->fault_text(0).find("node 1 SDO write 0x6081:0x00: abort 0x06090030 (invalid value for parameter)"),
+  EXPECT_NE(bank_->fault_text(0).find(
+                "node 1 SDO write 0x6081:0x00: abort 0x06090032 (value of parameter written too low)"),
             std::string::npos)
       << bank_->fault_text(0);
 }
@@ -620,8 +621,7 @@ TEST_F(CanopenWinchBankTest, EncoderWithTwoTpdosIsConfigured) {
   // GIVEN encoders with only two TPDOs (0x1802/0x1803 and 0x1A02/0x1A03 do
   // not exist: abort 0x06020000) and no RPDO, as Kübler Sendix and SIKO come
   virtual_robot::EncoderDefaults encoder;
-  encoder.quirks.tpdo_count = 2;
-  encoder.quirks.rpdo_count = 0;
+  encoder.eds = virtual_robot::shipped_eds("cdpr-virtual-encoder-two-tpdo.eds");
   start(two_winches(), {}, encoder);
   // WHEN the bank configures them THEN they are alive without a fault, TPDO2 switched off
   open_and_configure();
@@ -634,7 +634,7 @@ TEST_F(CanopenWinchBankTest, EncoderWithTwoTpdosIsConfigured) {
 TEST_F(CanopenWinchBankTest, DriveKeepingCobIdBit30IsConfigured) {
   // GIVEN drives that hold COB-ID bit 30 at 1 (no RTR) whatever is written, as Lika's manual requires
   virtual_robot::DriveDefaults drive;
-  drive.quirks.cob_id_bit30_fixed = true;
+  drive.eds = virtual_robot::shipped_eds("cdpr-virtual-drive-rtr-bit30.eds");
   start(two_winches(), drive);
   // WHEN the bank configures them THEN the read back 0x40000201 matches the 0x201 written
   open_and_configure();
@@ -653,7 +653,7 @@ TEST_F(CanopenWinchBankTest, DriveKeepingCobIdBit30IsConfigured) {
 TEST_F(CanopenWinchBankTest, DriveWithoutTransmissionType255GetsType254) {
   // GIVEN drives that refuse transmission type 255 (abort 0x06090030)
   virtual_robot::DriveDefaults drive;
-  drive.quirks.no_type_255 = true;
+  drive.eds = virtual_robot::shipped_eds("cdpr-virtual-drive-no-type-255.eds");
   start(two_winches(), drive);
   // WHEN the bank configures them THEN their PDOs are event-driven on type 254 and they are alive
   open_and_configure();
@@ -668,9 +668,9 @@ constexpr double kMPerMotorRev = 3.14159265358979323846 * 0.02 / 10.0;
 
 virtual_robot::DriveDefaults rpm_drive() {
   virtual_robot::DriveDefaults drive;
-  drive.rpm_units = true;
+  drive.eds = virtual_robot::shipped_eds("cdpr-virtual-drive-rpm.eds");
   drive.counts_per_rev = kMPerMotorRev / kDriveMPerCount;
-  drive.max_motor_speed_rpm = 60'000;
+  drive.stored[virtual_robot::object_key(0x6080, 0)] = 60'000;
   return drive;
 }
 
@@ -718,7 +718,7 @@ TEST_F(CanopenWinchBankTest, DriveInRpmWithoutMechanicsIsRefusedNamingTheNode) {
 TEST_F(CanopenWinchBankTest, ProfileAboveMaxMotorSpeedIsRefused) {
   // GIVEN drives in rpm whose 0x6080 allows 30000 rpm, and a profile velocity of 4 m/s (38197 rpm)
   virtual_robot::DriveDefaults drive = rpm_drive();
-  drive.max_motor_speed_rpm = 30'000;
+  drive.stored[virtual_robot::object_key(0x6080, 0)] = 30'000;
   start(rpm_winches(), drive);
   ASSERT_TRUE(bank_->open().ok());
   run_ms(300);
@@ -730,11 +730,152 @@ TEST_F(CanopenWinchBankTest, ProfileAboveMaxMotorSpeedIsRefused) {
       << bank_->fault_text(0);
 }
 
+TEST_F(CanopenWinchBankTest, EveryShippedVirtualDeviceEdsBuildsADeviceTheMasterConfiguresFromThatFile) {
+  // GIVEN each virtual device's EDS of systemd/eds, played by the devices
+  // (built in) and read by the master from the file, the others plain
+  struct Case {
+    const char* drive_eds;
+    const char* encoder_eds;
+  };
+  // (and the real devices' files, played from disk: consistent with what the daemon needs, not with the device)
+  for (const Case c : {Case{"cdpr-virtual-drive.eds", "cdpr-virtual-encoder.eds"},
+                       Case{"cdpr-virtual-drive-rtr-bit30.eds", "cdpr-virtual-encoder.eds"},
+                       Case{"cdpr-virtual-drive-no-type-255.eds", "cdpr-virtual-encoder.eds"},
+                       Case{"cdpr-virtual-drive-rpm.eds", "cdpr-virtual-encoder.eds"},
+                       Case{"cdpr-virtual-drive.eds", "cdpr-virtual-encoder-two-tpdo.eds"},
+                       Case{"maxon-epos4.eds", "kuebler-sendix.eds"}}) {
+    SCOPED_TRACE(std::string(c.drive_eds) + " + " + c.encoder_eds);
+    const bool real = std::string(c.drive_eds) == "maxon-epos4.eds";
+    const auto played = [real](const char* name) {
+      std::string error;
+      return real ? virtual_robot::read_device_eds(std::string(CDPR_SOURCE_DIR) + "/systemd/eds/" + name, error)
+                  : virtual_robot::shipped_eds(name);
+    };
+    virtual_robot::DriveDefaults drive = rpm_drive();
+    drive.eds = played(c.drive_eds);
+    drive.stored.clear();
+    virtual_robot::EncoderDefaults encoder;
+    encoder.eds = played(c.encoder_eds);
+    ASSERT_EQ(virtual_robot::Cia402Device::check(1, drive), "");
+    ASSERT_EQ(virtual_robot::Cia406Device::check(11, encoder), "");
+    CanWinchBankConfig config = rpm_winches();
+    config.drive.profile_velocity_mps = 1.0;  // 9549 rpm: below the rpm drive's 0x6080 of 10000
+    config.drive.eds = std::string(CDPR_SOURCE_DIR) + "/systemd/eds/" + c.drive_eds;
+    config.encoder.eds = std::string(CDPR_SOURCE_DIR) + "/systemd/eds/" + c.encoder_eds;
+    start(config, drive, encoder);
+    ASSERT_EQ(bank_->setup_error(), "");
+    // WHEN configured, enabled and moved 0.2 m THEN no fault, and on target
+    open_and_enable();
+    const double start_m = bank_->status(0).payout_m;
+    ASSERT_TRUE(bank_->set_target_payout(0, start_m + 0.2).ok());
+    run_ms(800);
+    EXPECT_TRUE(bank_->motion_finished());
+    EXPECT_NEAR(bank_->status(0).payout_m, start_m + 0.2, kEncoderMPerCount);
+    for (int i = 0; i < 2; ++i) EXPECT_FALSE(bank_->status(i).fault) << bank_->fault_text(i);
+  }
+}
+
+TEST_F(CanopenWinchBankTest, AWinchWhoseDriveDiffersIsConfiguredFromItsOwnEds) {
+  // GIVEN winch 0 with the virtual drive (counts/s) and winch 1 with a drive
+  // in rpm, each named by its EDS: [winches.drive] eds and winch 1's drive_eds
+  CanWinchBankConfig config = rpm_winches();
+  config.drive.profile_velocity_mps = 1.0;  // 9549 rpm, within the rpm drive's 0x6080
+  config.drive.eds = std::string(CDPR_SOURCE_DIR) + "/systemd/eds/cdpr-virtual-drive.eds";
+  config.winches[1].drive_eds = std::string(CDPR_SOURCE_DIR) + "/systemd/eds/cdpr-virtual-drive-rpm.eds";
+  int fds[2];
+  ASSERT_EQ(::socketpair(AF_UNIX, SOCK_STREAM, 0, fds), 0);
+  bus_ = std::make_unique<test::FakeCanopenBus>(fds[1]);
+  bus_->add(1, 11);
+  virtual_robot::DriveDefaults rpm = rpm_drive();
+  rpm.stored.clear();
+  bus_->add(2, 12, rpm);
+  const int bank_fd = fds[0];
+  bank_ = std::make_unique<CanopenWinchBank>(config, [bank_fd]() -> hal::Result<std::unique_ptr<CanTransport>> {
+    return std::unique_ptr<CanTransport>(std::make_unique<FdCanTransport>(bank_fd, "test bank"));
+  });
+  ASSERT_EQ(bank_->setup_error(), "");
+  EXPECT_EQ(bank_->nodes_without_eds(), "encoders 11, 12");
+  // WHEN configured THEN each drive has 1 m/s in its own unit: 5000 counts/s and 9549 rpm
+  open_and_configure();
+  EXPECT_EQ(bus_->drive(0).od().get(0x6081, 0), 5000u);
+  EXPECT_EQ(bus_->drive(1).od().get(0x6081, 0), 9549u);
+  // AND a coordinated move takes both to their targets
+  ASSERT_TRUE(bank_->enable().ok());
+  run_ms(100);
+  const double to_m[2] = {bank_->status(0).payout_m + 0.4, bank_->status(1).payout_m + 0.2};
+  ASSERT_TRUE(bank_->set_target_payouts(to_m).ok());
+  run_ms(1000);
+  for (int i = 0; i < 2; ++i) EXPECT_NEAR(bank_->status(i).payout_m, to_m[i], kEncoderMPerCount) << "winch " << i;
+}
+
+// The shipped virtual drive's EDS with `sections` added (objects of the factor group).
+virtual_robot::DriveDefaults drive_with(const std::string& sections) {
+  virtual_robot::DriveDefaults drive;
+  drive.eds.text += "\n" + sections;
+  return drive;
+}
+
+std::string factor_group(const char* index, const char* name, int numerator, int divisor) {
+  std::string text = std::string("[") + index + "]\nParameterName=" + name + "\nObjectType=0x8\nSubNumber=3\n\n";
+  text += std::string("[") + index + "sub0]\nDataType=0x0005\nAccessType=ro\nDefaultValue=2\n\n";
+  text += std::string("[") + index + "sub1]\nDataType=0x0007\nAccessType=rw\nDefaultValue=" + std::to_string(numerator) + "\n\n";
+  text += std::string("[") + index + "sub2]\nDataType=0x0007\nAccessType=rw\nDefaultValue=" + std::to_string(divisor) + "\n\n";
+  return text;
+}
+
+TEST_F(CanopenWinchBankTest, DriveWithAVelocityAndAccelerationFactorGetsItsProfileDividedByThem) {
+  // GIVEN drives with a velocity factor 0x6096 = 2/1 and an acceleration factor 0x6097 = 4/1 (no EDS given)
+  start(two_winches(), drive_with(factor_group("6096", "Velocity factor", 2, 1) +
+                                  factor_group("6097", "Acceleration factor", 4, 1)));
+  // WHEN configured THEN 4 m/s (20000 counts/s) is written as 10000 and 40 m/s^2 (200000 counts/s^2) as 50000
+  open_and_configure();
+  EXPECT_EQ(bus_->drive(0).od().get(0x6081, 0), 10000u);
+  EXPECT_EQ(bus_->drive(0).od().get(0x6083, 0), 50000u);
+  EXPECT_EQ(bus_->drive(0).od().get(0x6085, 0), 50000u);
+  // AND a move of 0.8 m runs the profile the configuration asks: at 4 m/s and 40 m/s^2 it takes 0.3 s
+  ASSERT_TRUE(bank_->enable().ok());
+  run_ms(100);
+  const double to_m[2] = {bank_->status(0).payout_m + 0.8, bank_->status(1).payout_m + 0.4};
+  ASSERT_TRUE(bank_->set_target_payouts(to_m).ok());
+  run_ms(450);  // the profile SDO writes, the set-point handshake and 0.3 s of motion
+  for (int i = 0; i < 2; ++i) EXPECT_NEAR(bank_->status(i).payout_m, to_m[i], kEncoderMPerCount) << "winch " << i;
+  EXPECT_TRUE(bank_->motion_finished());
+}
+
+TEST_F(CanopenWinchBankTest, GearRatioWithRpmIsAStartErrorNamingNodeObjectAndValue) {
+  // GIVEN rpm drives whose EDS has a gear ratio 0x6091 of 10 / 1, given to the daemon
+  virtual_robot::DriveDefaults drive = rpm_drive();
+  drive.eds.text += "\n" + factor_group("6091", "Gear ratio", 10, 1);
+  drive.eds.name = ::testing::TempDir() + "geared-rpm.eds";
+  {
+    std::FILE* f = std::fopen(drive.eds.name.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fputs(drive.eds.text.c_str(), f);
+    std::fclose(f);
+  }
+  CanWinchBankConfig config = rpm_winches();
+  config.drive.eds = drive.eds.name;
+  start(config, drive);
+  // THEN refused at start, before anything is written, naming node, object and value
+  EXPECT_EQ(bank_->setup_error(),
+            "node 1: 0x6091 (gear ratio) = 10 / 1 with velocities in rpm: whose revolutions those are is the "
+            "drive's reading; set it to 1 / 1 and the gear in [winches.mechanics] gear_ratio");
+  EXPECT_FALSE(bank_->open().ok());
+  // AND without the EDS the same drive is refused when its probe reads 0x6091, as a latched fault
+  config.drive.eds.clear();
+  start(config, drive);
+  ASSERT_TRUE(bank_->open().ok());
+  run_ms(300);
+  EXPECT_TRUE(bank_->status(0).fault);
+  EXPECT_NE(bank_->fault_text(0).find("node 1: 0x6091 (gear ratio) = 10 / 1"), std::string::npos)
+      << bank_->fault_text(0);
+  EXPECT_EQ(bus_->drive(0).od().get(0x1800, 5), 0u);  // nothing configured after the probe
+}
+
 TEST_F(CanopenWinchBankTest, EncoderDescribedByItsEdsIsNotAskedForPdosItLacks) {
   // GIVEN 2-TPDO encoders and their EDS in the configuration
   virtual_robot::EncoderDefaults encoder;
-  encoder.quirks.tpdo_count = 2;
-  encoder.quirks.rpdo_count = 0;
+  encoder.eds = virtual_robot::shipped_eds("cdpr-virtual-encoder-two-tpdo.eds");
   CanWinchBankConfig config = two_winches();
   config.encoder.eds = std::string(CDPR_SOURCE_DIR) + "/systemd/eds/kuebler-sendix.eds";
   start(config, {}, encoder);
@@ -792,7 +933,7 @@ TEST_F(CanopenWinchBankTest, SoftwarePositionLimitsFollowThePayoutRange) {
 TEST_F(CanopenWinchBankTest, ReplacementEncoderCountingTheOtherWayIsRefused) {
   // GIVEN the configuration's code sequence 0 (counting up clockwise) and encoders set to 1
   virtual_robot::EncoderDefaults encoder;
-  encoder.operating_parameters = 0x0001;
+  encoder.stored[virtual_robot::object_key(0x6000, 0)] = 0x0001;
   CanWinchBankConfig config = two_winches();
   config.encoder.code_sequence = 0;
   config.encoder.counts_per_revolution = 4096;
@@ -824,6 +965,40 @@ TEST_F(CanopenWinchBankTest, PayoutPastHalfTheEncoderRangeReadsTheSameAfterARest
   bus_->winch(0).encoder_offset = 3 * (1 << 23);
   open_and_configure();
   EXPECT_NEAR(bank_->status(0).payout_m, payout_m, 1e-9);
+}
+
+TEST_F(CanopenWinchBankTest, PayoutPastHalfTheRangeFromItsStartReadsTheSameAfterARestartFromTheKeptPosition) {
+  // GIVEN encoders with a 100000-count measuring range (10 m at 0.1 mm), winch 0's at raw 45000,
+  // no payout range, and the positions kept in a file
+  virtual_robot::EncoderDefaults encoder;
+  encoder.stored[virtual_robot::object_key(0x6002, 0)] = 100'000;
+  CanWinchBankConfig config = two_winches();
+  config.last_positions_path = ::testing::TempDir() + "winch-positions-" + std::to_string(::getpid());
+  std::remove(config.last_positions_path.c_str());
+  start(config, {}, encoder);
+  bus_->winch(0).encoder_offset = 45'000;
+  open_and_configure();
+  ASSERT_NEAR(bank_->status(0).payout_m, 4.5, 1e-9);
+  // WHEN the cable pays out past half the range from zero (to raw 65000, at 8 m/s) and the daemon restarts
+  for (int step = 0; step < 50; ++step) {
+    bus_->winch(0).encoder_offset += 400;
+    run_ms(5);
+  }
+  ASSERT_NEAR(bank_->status(0).payout_m, 6.5, 1e-9) << bank_->fault_text(0);
+  bank_->close();
+  start(config, {}, encoder);
+  bus_->winch(0).encoder_offset = 65'000;
+  open_and_configure();
+  // THEN it reads 6.5 m, not a whole range (10 m) less
+  EXPECT_NEAR(bank_->status(0).payout_m, 6.5, 1e-9);
+  // AND without the kept position (as before) the first reading is taken nearest zero: -3.5 m
+  bank_->close();
+  config.last_positions_path.clear();
+  start(config, {}, encoder);
+  bus_->winch(0).encoder_offset = 65'000;
+  open_and_configure();
+  EXPECT_NEAR(bank_->status(0).payout_m, -3.5, 1e-9);
+  std::remove((::testing::TempDir() + "winch-positions-" + std::to_string(::getpid())).c_str());
 }
 
 TEST(CanopenWinchBankConfig, RejectsSharedNodeIdsAndZeroScales) {

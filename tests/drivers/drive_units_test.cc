@@ -49,4 +49,59 @@ TEST(DriveUnits, TooSmallAFigureRoundsToZeroForTheDriveToRefuse) {
 }
 
 }  // namespace
+TEST(DriveUnits, TheFactorGroupIsHonouredAndAnAccelerationUnitOfItsOwnConverted) {
+  // GIVEN a drive in increments (1e-4 m per count) with a velocity factor 2/1 and an acceleration factor 1/4
+  DriveUnitObjects objects;
+  objects.velocity_numerator = 2;
+  objects.velocity_divisor = 1;
+  objects.acceleration_numerator = 1;
+  objects.acceleration_divisor = 4;
+  std::string why;
+  std::optional<DriveUnits> units = drive_units(objects, 1e-4, 0.0, why);
+  ASSERT_TRUE(units) << why;
+  // THEN 1 m/s (10000 counts/s inside the drive) is written as 5000, 1 m/s^2 as 40000
+  EXPECT_EQ(drive_value(*units, 1.0), 5000u);
+  EXPECT_EQ(drive_acceleration(*units, 1.0), 40000u);
+  // AND an rpm drive with 0x60AA = 0xFFB40300 (0.1 rev/s^2) and 2e-3*pi m per motor revolution: 1 m/s^2 is 1591.5
+  DriveUnitObjects rpm;
+  rpm.si_unit_velocity = 0x00B44700;
+  rpm.si_unit_acceleration = 0xFFB40300;
+  units = drive_units(rpm, 1e-4, 2e-3 * 3.14159265358979323846, why);
+  ASSERT_TRUE(units) << why;
+  EXPECT_EQ(drive_value(*units, 1.0), 9549u);
+  EXPECT_EQ(drive_acceleration(*units, 1.0), 1592u);
+}
+
+TEST(DriveUnits, AFactorTheDaemonCannotHonourIsRefusedNamingObjectAndValue) {
+  std::string why;
+  // GIVEN a drive in rpm whose gear ratio 0x6091 is 10 / 1: whose rpm are those?
+  DriveUnitObjects geared;
+  geared.si_unit_velocity = 0x00B44700;
+  geared.gear_motor_revs = 10;
+  geared.gear_shaft_revs = 1;
+  EXPECT_FALSE(drive_units(geared, 1e-4, 0.01, why));
+  EXPECT_EQ(why,
+            "0x6091 (gear ratio) = 10 / 1 with velocities in rpm: whose revolutions those are is the drive's reading; "
+            "set it to 1 / 1 and the gear in [winches.mechanics] gear_ratio");
+  // AND a zero divisor, a lone numerator, an acceleration unit per minute
+  DriveUnitObjects zero;
+  zero.velocity_numerator = 1;
+  zero.velocity_divisor = 0;
+  EXPECT_FALSE(drive_units(zero, 1e-4, 0.0, why));
+  EXPECT_EQ(why, "0x6096 (velocity factor) = 1 / 0: not a factor the daemon can honour");
+  DriveUnitObjects lone;
+  lone.acceleration_numerator = 3;
+  EXPECT_FALSE(drive_units(lone, 1e-4, 0.0, why));
+  EXPECT_EQ(why, "0x6097 (acceleration factor) = 3 / ?: not a factor the daemon can honour");
+  DriveUnitObjects per_minute;
+  per_minute.si_unit_acceleration = 0x00B54700;
+  EXPECT_FALSE(drive_units(per_minute, 1e-4, 0.0, why));
+  EXPECT_NE(why.find("0x60AA (SI unit acceleration) = 0x00B54700"), std::string::npos) << why;
+  // AND a gear in increments is the drive's own business (positions are per 0x6064 unit)
+  DriveUnitObjects increments;
+  increments.gear_motor_revs = 10;
+  increments.gear_shaft_revs = 1;
+  EXPECT_TRUE(drive_units(increments, 1e-4, 0.0, why)) << why;
+}
+
 }  // namespace cdpr::drivers::can

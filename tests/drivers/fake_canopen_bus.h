@@ -34,10 +34,12 @@ class FakeCanopenBus {
                           virtual_robot::EncoderDefaults encoder_defaults = {})
       : transport_(fd, "fake bus"), drive_defaults_(drive_defaults), encoder_defaults_(encoder_defaults) {}
 
-  Winch& add(int node_id, int encoder_node_id) {
+  Winch& add(int node_id, int encoder_node_id) { return add(node_id, encoder_node_id, drive_defaults_); }
+  // ... with a drive of its own (another make than the bus's others).
+  Winch& add(int node_id, int encoder_node_id, const virtual_robot::DriveDefaults& drive) {
     winches_.push_back(Winch{});
     Winch& w = winches_.back();
-    w.drive = std::make_unique<virtual_robot::Cia402Device>(node_id, drive_defaults_);
+    w.drive = std::make_unique<virtual_robot::Cia402Device>(node_id, drive);
     if (encoder_node_id != 0) w.encoder = std::make_unique<virtual_robot::Cia406Device>(encoder_node_id, encoder_defaults_);
     return w;
   }

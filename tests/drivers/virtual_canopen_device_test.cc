@@ -9,6 +9,7 @@
 
 #include "virtual-robot/cia402_device.h"
 #include "virtual-robot/cia406_device.h"
+#include "virtual-robot/object_dictionary_eds.h"
 
 namespace cdpr::virtual_robot {
 namespace {
@@ -151,6 +152,57 @@ TEST(VirtualCanopenDevice, ConsumerHeartbeatLossQuickStopsPer0x6007) {
   bool emcy_frame = false;
   for (const BusFrame& f : out) emcy_frame = emcy_frame || (f.id == 0x80u + kNode && f.data[0] == 0x30 && f.data[1] == 0x81);
   EXPECT_TRUE(emcy_frame);
+}
+
+// `eds` without the section [name] and its keys.
+DeviceEds without_section(DeviceEds eds, const std::string& name) {
+  const std::size_t at = eds.text.find("[" + name + "]");
+  EXPECT_NE(at, std::string::npos) << name;
+  eds.text.erase(at, eds.text.find("\n\n", at) + 2 - at);
+  eds.name = "broken.eds";
+  return eds;
+}
+
+TEST(VirtualCanopenDevice, EdsLackingAnObjectTheDevicePlaysIsRefusedNamingIt) {
+  // GIVEN the shipped EDS files, each with one object the device uses taken out
+  DriveDefaults drive;
+  EXPECT_EQ(Cia402Device::check(kNode, drive), "");
+  drive.eds = without_section(drive.eds, "6041");
+  EncoderDefaults encoder;
+  EXPECT_EQ(Cia406Device::check(kNode, encoder), "");
+  encoder.eds = without_section(encoder.eds, "6004");
+  DriveDefaults rpm;
+  rpm.eds = without_section(shipped_eds("cdpr-virtual-drive-rpm.eds"), "6080");
+  DriveDefaults no_event_timer;
+  no_event_timer.eds = without_section(no_event_timer.eds, "1800sub5");
+  // WHEN checked THEN refused, naming file and object, before any device plays it
+  EXPECT_EQ(Cia402Device::check(kNode, drive), "broken.eds: no object 0x6041:00 (statusword), which the drive plays");
+  EXPECT_EQ(Cia406Device::check(kNode, encoder), "broken.eds: no object 0x6004:00, which the encoder plays");
+  EXPECT_EQ(Cia402Device::check(kNode, rpm),
+            "broken.eds: no object 0x6080:00 (max motor speed), which a drive in rpm plays");
+  EXPECT_EQ(Cia402Device::check(kNode, no_event_timer), "broken.eds: no object 0x1800:05");
+}
+
+TEST(VirtualCanopenDevice, ObjectsComeFromTheEdsWithNodeIdRangeAndStoredValues) {
+  // GIVEN a drive from the no-type-255 EDS, stored to power on in homing
+  DriveDefaults drive;
+  drive.eds = shipped_eds("cdpr-virtual-drive-no-type-255.eds");
+  drive.stored[object_key(0x6060, 0)] = 6;
+  Cia402Device d(kNode, drive);
+  // THEN $NODEID is its own id, the stored mode is in effect, 255 is above the range and 254 taken
+  EXPECT_EQ(d.od().get(0x1800, 1), 0x180u + kNode);
+  EXPECT_EQ(d.od().get(0x6061, 0), 6u);
+  EXPECT_EQ(write(d, 0x1800, 2, 255, 1), 0x06090031u);
+  EXPECT_EQ(write(d, 0x1800, 2, 254, 1), 0u);
+  // AND an NMT reset node brings back the stored mode, not the EDS's DefaultValue
+  EXPECT_EQ(write(d, 0x6060, 0, 1, 1), 0u);
+  d.on_frame(BusFrame{0x000, 2, {0x81, kNode}}, 0);
+  EXPECT_EQ(d.od().get(0x6060, 0), 6u);
+  // AND a drive from the rtr-bit30 EDS keeps bit 30 whatever is written
+  drive.eds = shipped_eds("cdpr-virtual-drive-rtr-bit30.eds");
+  Cia402Device rtr(kNode, drive);
+  EXPECT_EQ(write(rtr, 0x1400, 1, 0x80000000u | (0x200u + kNode), 4), 0u);
+  EXPECT_EQ(rtr.od().get(0x1400, 1), 0xC0000000u | (0x200u + kNode));
 }
 
 }  // namespace

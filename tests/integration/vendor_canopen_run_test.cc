@@ -1,10 +1,11 @@
 // The full field calibration against the virtual robot whose CANopen nodes
-// play a vendor quirk (docs/fieldbus.md, "Vendor quirks"): 2-TPDO encoders,
-// COB-ID bit 30 held at 1, no transmission type 255, drives in rpm. The
-// daemon, configured as for any robot (plus the winches' mechanics), must
-// configure every node and commit a calibration whose anchors are within
-// 0.10 m of the truth, as FullCalibration's acceptance run does with the
-// profiles' defaults. One calibration per quirk, of 12 waypoints: the
+// play a vendor quirk profile (docs/fieldbus.md, "Vendor quirks"), each a
+// shipped EDS file: 2-TPDO encoders, COB-ID bit 30 held at 1, no
+// transmission type 255, drives in rpm. The daemon, configured as for any
+// robot with the EDS files the nodes play (plus the winches' mechanics),
+// must configure every node and commit a calibration whose anchors are
+// within 0.10 m of the truth, as FullCalibration's acceptance run does with
+// the profiles' defaults. One calibration per quirk, of 12 waypoints: the
 // quirks act in the configuration and in every move, and four 35-waypoint
 // runs would cost CI's sanitizer stage some 20 minutes.
 
@@ -17,15 +18,20 @@
 namespace cdpr::integration {
 namespace {
 
-class VendorCanopenRun : public ::testing::TestWithParam<const char*> {};
+class VendorCanopenRun : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(VendorCanopenRun, CalibratesTheLargeRobotWithin10cm) {
   // GIVEN the acceptance robot whose nodes play the quirk, and the daemon with its shipped defaults
   virtual_robot::VirtualRobotOptions options = large_robot_acceptance_options();
-  const auto quirks = virtual_robot::parse_canopen_quirks(GetParam());
-  ASSERT_TRUE(quirks);
-  options.nodes.quirks = *quirks;
-  VirtualRobotRig rig(options, [](VirtualRobotRig& r) { r.config.calibrator.planner.waypoint_count = 12; });
+  std::string error;
+  const auto quirks = virtual_robot::parse_canopen_quirks(GetParam(), error);
+  ASSERT_TRUE(quirks) << error;
+  virtual_robot::CanopenNodes::apply(*quirks, options.nodes);
+  VirtualRobotRig rig(options, [&quirks](VirtualRobotRig& r) {
+    r.config.calibrator.planner.waypoint_count = 12;
+    r.config.winches.drive.eds = std::string(CDPR_SOURCE_DIR) + "/systemd/eds/" + quirks->drive_eds;
+    r.config.winches.encoder.eds = std::string(CDPR_SOURCE_DIR) + "/systemd/eds/" + quirks->encoder_eds;
+  });
 
   // WHEN the operator starts a calibration and it runs to its end
   std::this_thread::sleep_for(std::chrono::seconds(1));
@@ -49,18 +55,18 @@ TEST_P(VendorCanopenRun, CalibratesTheLargeRobotWithin10cm) {
   const Truth& truth = rig.robot->truth();
   for (int i = 0; i < kCableCount; ++i) {
     const double error_m = (calibration.winches[i].anchor_world - truth.winches[i].anchor_world).norm();
-    std::printf("%s: cable %d anchor error %.4f m\n", GetParam(), i, error_m);
+    std::printf("%s: cable %d anchor error %.4f m\n", GetParam().c_str(), i, error_m);
     EXPECT_LT(error_m, 0.10) << "cable " << i;
   }
   rig.keep_dir = ::testing::Test::HasFailure();
 }
 
 INSTANTIATE_TEST_SUITE_P(Quirks, VendorCanopenRun,
-                         ::testing::Values("two-tpdo-encoder", "rtr-bit30", "no-type-255", "rpm-units"),
+                         ::testing::ValuesIn(virtual_robot::canopen_quirk_names()),
                          [](const auto& info) {
                            std::string name;
-                           for (const char* c = info.param; *c != '\0'; ++c) {
-                             if (*c != '-') name += *c;
+                           for (const char c : info.param) {
+                             if (c != '-') name += c;
                            }
                            return name;
                          });

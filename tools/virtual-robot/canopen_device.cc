@@ -1,6 +1,8 @@
 #include "virtual-robot/canopen_device.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <utility>
 
 namespace cdpr::virtual_robot {
 namespace {
@@ -23,49 +25,46 @@ bool is_pdo_mapping(std::uint16_t index) {
   return (index >= 0x1600 && index <= 0x1603) || (index >= 0x1A00 && index <= 0x1A03);
 }
 
+int pdo_count(const ObjectDictionary& od, std::uint16_t first) {
+  int n = 0;
+  while (n < 4 && od.find(static_cast<std::uint16_t>(first + n), 1) != nullptr) ++n;
+  return n;
+}
+
+std::string object_name(std::uint16_t index, std::uint8_t subindex) {
+  char text[16];
+  std::snprintf(text, sizeof(text), "0x%04X:%02X", index, subindex);
+  return text;
+}
+
 }  // namespace
 
-CanopenDevice::CanopenDevice(int node_id, const DeviceIdentity& identity, const CommunicationQuirks& quirks)
-    : node_id_(node_id), quirks_(quirks) {
-  od_.add(0x1000, 0, 4, Access::kReadOnly, false, identity.device_type);
-  od_.add(0x1001, 0, 1, Access::kReadOnly, true, 0);
-  od_.add(0x1016, 0, 1, Access::kReadOnly, false, 1);
-  od_.add(0x1016, 1, 4, Access::kReadWrite, false, 0);
-  od_.add(0x1017, 0, 2, Access::kReadWrite, false, 0);  // heartbeat producer off until configured
-  od_.add(0x1018, 0, 1, Access::kReadOnly, false, 4);
-  od_.add(0x1018, 1, 4, Access::kReadOnly, false, identity.vendor_id);
-  od_.add(0x1018, 2, 4, Access::kReadOnly, false, identity.product_code);
-  od_.add(0x1018, 3, 4, Access::kReadOnly, false, identity.revision);
-  od_.add(0x1018, 4, 4, Access::kReadOnly, false, identity.serial);
+std::string CanopenDevice::check_communication_objects(const ObjectDictionary& od) {
+  std::vector<std::pair<std::uint16_t, std::uint8_t>> needed{{0x1001, 0}, {0x1016, 1}, {0x1017, 0}};
+  for (int n = 0; n < pdo_count(od, 0x1400); ++n) {
+    for (std::uint8_t sub : {1, 2}) needed.emplace_back(0x1400 + n, sub);
+    needed.emplace_back(0x1600 + n, 0);
+  }
+  for (int n = 0; n < pdo_count(od, 0x1800); ++n) {
+    for (std::uint8_t sub : {1, 2, 3, 5}) needed.emplace_back(0x1800 + n, sub);
+    needed.emplace_back(0x1A00 + n, 0);
+  }
+  for (const auto& [index, subindex] : needed) {
+    if (od.find(index, subindex) == nullptr) return "no object " + object_name(index, subindex);
+  }
+  // A mapping's power-on entries must exist.
+  for (std::uint16_t mapping = 0x1600; mapping <= 0x1A03; ++mapping) {
+    const OdEntry* count = is_pdo_mapping(mapping) ? od.find(mapping, 0) : nullptr;
+    if (count == nullptr) continue;
+    for (std::uint8_t sub = 1; sub <= count->default_value; ++sub) {
+      if (od.find(mapping, sub) == nullptr) return "no object " + object_name(mapping, sub) + " of the mapped count";
+    }
+  }
+  return {};
 }
 
-void CanopenDevice::add_communication_objects(const std::array<PdoDefault, 4>& rpdos,
-                                              const std::array<PdoDefault, 4>& tpdos) {
-  const std::uint32_t rtr = quirks_.cob_id_bit30_fixed ? kPdoNoRtr : 0;
-  const std::uint32_t type = quirks_.no_type_255 ? 254 : 255;
-  const auto add_mapping = [this](std::uint16_t index, const PdoDefault& pdo) {
-    od_.add(index, 0, 1, Access::kReadWrite, false, static_cast<std::uint32_t>(pdo.mapping.size()));
-    for (std::uint8_t sub = 1; sub <= 8; ++sub) {
-      od_.add(index, sub, 4, Access::kReadWrite, false, sub <= pdo.mapping.size() ? pdo.mapping[sub - 1] : 0);
-    }
-  };
-  for (int n = 0; n < quirks_.rpdo_count; ++n) {
-    const auto rx = static_cast<std::uint16_t>(0x1400 + n);
-    od_.add(rx, 0, 1, Access::kReadOnly, false, 2);
-    od_.add(rx, 1, 4, Access::kReadWrite, false, rtr | rpdos[n].cob_id);
-    od_.add(rx, 2, 1, Access::kReadWrite, false, type);
-    add_mapping(static_cast<std::uint16_t>(0x1600 + n), rpdos[n]);
-  }
-  for (int n = 0; n < quirks_.tpdo_count; ++n) {
-    const auto tx = static_cast<std::uint16_t>(0x1800 + n);
-    od_.add(tx, 0, 1, Access::kReadOnly, false, 5);
-    od_.add(tx, 1, 4, Access::kReadWrite, false, rtr | tpdos[n].cob_id);
-    od_.add(tx, 2, 1, Access::kReadWrite, false, type);
-    od_.add(tx, 3, 2, Access::kReadWrite, false, 0);
-    od_.add(tx, 5, 2, Access::kReadWrite, false, 0);
-    add_mapping(static_cast<std::uint16_t>(0x1A00 + n), tpdos[n]);
-  }
-}
+CanopenDevice::CanopenDevice(int node_id, ObjectDictionary od)
+    : node_id_(node_id), od_(std::move(od)), rpdo_count_(pdo_count(od_, 0x1400)), tpdo_count_(pdo_count(od_, 0x1800)) {}
 
 void CanopenDevice::reset(bool communication_only) {
   od_.reset(communication_only);
@@ -111,7 +110,7 @@ void CanopenDevice::on_frame(const BusFrame& frame, hal::TimeUs now_us) {
     return;
   }
   if (state_ != NodeState::kOperational) return;  // PDOs only when operational
-  for (int n = 0; n < quirks_.rpdo_count; ++n) {
+  for (int n = 0; n < rpdo_count_; ++n) {
     const std::uint32_t cob = od_.get(static_cast<std::uint16_t>(0x1400 + n), 1);
     if ((cob & kPdoInvalid) == 0 && (cob & 0x7FF) == frame.id) on_rpdo_frame(n, frame, now_us);
   }
@@ -167,7 +166,6 @@ std::uint32_t CanopenDevice::check_pdo_write(std::uint16_t index, std::uint8_t s
     if ((value & 0x7FF) == 0 || (value & 0x1FFFF800) != 0) return abort_code::kInvalidValue;
   }
   if (is_pdo_communication(index) && subindex == 2 && value > 240 && value < 254) return abort_code::kInvalidValue;
-  if (is_pdo_communication(index) && subindex == 2 && value == 255 && quirks_.no_type_255) return abort_code::kInvalidValue;
   if (is_pdo_mapping(index)) {
     const auto communication = static_cast<std::uint16_t>(index - 0x200);
     if ((od_.get(communication, 1) & kPdoInvalid) == 0) return abort_code::kDeviceState;  // PDO still valid
@@ -175,6 +173,7 @@ std::uint32_t CanopenDevice::check_pdo_write(std::uint16_t index, std::uint8_t s
     if (value > 8) return abort_code::kInvalidValue;
     std::uint32_t bits = 0;
     for (std::uint8_t sub = 1; sub <= value; ++sub) {
+      if (od_.find(index, static_cast<std::uint8_t>(sub)) == nullptr) return abort_code::kInvalidValue;  // fewer entries
       const std::uint32_t entry = od_.get(index, sub);
       const OdEntry* mapped = od_.find(static_cast<std::uint16_t>(entry >> 16), static_cast<std::uint8_t>(entry >> 8));
       const bool rx = index < 0x1A00;
@@ -195,7 +194,9 @@ std::uint32_t CanopenDevice::write(std::uint16_t index, std::uint8_t subindex, s
   if (e->access == Access::kReadOnly) return abort_code::kReadOnly;
   if (size != 0 && size != e->size) return abort_code::kLength;
   if (e->size < 4) value &= (1u << (8 * e->size)) - 1;
-  if (is_pdo_communication(index) && subindex == 1 && quirks_.cob_id_bit30_fixed) value |= kPdoNoRtr;
+  if (const std::uint32_t code = ObjectDictionary::check_range(*e, value); code != 0) return code;
+  // A device without RTR keeps bit 30 as its default has it.
+  if (is_pdo_communication(index) && subindex == 1 && (e->default_value & kPdoNoRtr) != 0) value |= kPdoNoRtr;
   if (is_pdo_communication(index) || is_pdo_mapping(index)) {
     if (const std::uint32_t code = check_pdo_write(index, subindex, value); code != 0) return code;
   }
@@ -301,7 +302,7 @@ bool CanopenDevice::tpdo_data(int pdo, BusFrame& frame) const {
 }
 
 void CanopenDevice::send_tpdos(hal::TimeUs now_us, bool sync) {
-  for (int n = 0; n < quirks_.tpdo_count; ++n) {
+  for (int n = 0; n < tpdo_count_; ++n) {
     BusFrame frame;
     if (!tpdo_data(n, frame)) continue;
     const auto comm = static_cast<std::uint16_t>(0x1800 + n);

@@ -21,6 +21,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "hal/clock.h"
@@ -36,36 +37,10 @@ struct BusFrame {
 
 enum class NodeState : std::uint8_t { kBootUp = 0x00, kStopped = 0x04, kOperational = 0x05, kPreOperational = 0x7F };
 
-struct DeviceIdentity {
-  std::uint32_t device_type = 0;  // 0x1000
-  std::uint32_t vendor_id = 0;    // 0x1018:01
-  std::uint32_t product_code = 0; // 0x1018:02
-  std::uint32_t revision = 0;     // 0x1018:03
-  std::uint32_t serial = 0;       // 0x1018:04
-};
-
-// Where a device departs from the most common reading of CiA 301, as
-// devices in the field do (docs/fieldbus.md, "Vendor quirks"): fewer PDOs
-// than four (objects 0x14xx/0x16xx/0x18xx/0x1Axx beyond the count do not
-// exist: abort 0x06020000), COB-ID bit 30 kept at 1 whatever is written (no
-// RTR), transmission type 255 refused (0x06090030) with 254 the default.
-struct CommunicationQuirks {
-  int rpdo_count = 4;  // 0..4
-  int tpdo_count = 4;  // 0..4
-  bool cob_id_bit30_fixed = false;
-  bool no_type_255 = false;
-};
-
-// One PDO's power-on default: COB-ID (bit 31 set: not valid) and mapping
-// entries (index << 16 | subindex << 8 | bits).
-struct PdoDefault {
-  std::uint32_t cob_id = 0x80000000;
-  std::vector<std::uint32_t> mapping;
-};
-
 class CanopenDevice {
  public:
-  CanopenDevice(int node_id, const DeviceIdentity& identity, const CommunicationQuirks& quirks = {});
+  // `od`: the device's objects, power-on values as defaults (check_communication_objects() passed).
+  CanopenDevice(int node_id, ObjectDictionary od);
   virtual ~CanopenDevice() = default;
   CanopenDevice(const CanopenDevice&) = delete;
   CanopenDevice& operator=(const CanopenDevice&) = delete;
@@ -86,16 +61,17 @@ class CanopenDevice {
   void power_on_reset() { reset(false); }
   // Emergency messages sent so far (error codes), for tests.
   const std::vector<std::uint16_t>& emergencies() const { return emergencies_; }
+  // Empty when `od` has every communication object this device plays
+  // (0x1001, 0x1016:01, 0x1017, and each PDO's parameters), else the first missing.
+  static std::string check_communication_objects(const ObjectDictionary& od);
+  int rpdo_count() const { return rpdo_count_; }
+  int tpdo_count() const { return tpdo_count_; }
   // The longest time between two heartbeats of the producer it consumes
   // (0x1016) as this node heard them: the master's worst gap, plus any
   // delay of the robot's own thread.
   hal::TimeUs longest_consumer_gap_us() const { return longest_consumer_gap_us_; }
 
  protected:
-  // Call once from the profile's constructor after its objects are added:
-  // the predefined PDO sets (the first rpdo_count RPDOs and tpdo_count
-  // TPDOs of these, as the quirks say) and the communication objects.
-  void add_communication_objects(const std::array<PdoDefault, 4>& rpdos, const std::array<PdoDefault, 4>& tpdos);
   // Sends EMCY `code` (0 = error reset) and sets the error register.
   void emergency(std::uint16_t code, std::uint8_t error_register);
 
@@ -138,8 +114,9 @@ class CanopenDevice {
   void queue(std::uint32_t id, std::initializer_list<std::uint8_t> bytes);
 
   int node_id_;
-  CommunicationQuirks quirks_;
   ObjectDictionary od_;
+  int rpdo_count_ = 0;  // 0..4: the PDOs the dictionary has
+  int tpdo_count_ = 0;
   NodeState state_ = NodeState::kPreOperational;
   bool boot_up_pending_ = true;
   bool silent_ = false;

@@ -11,50 +11,74 @@ drivers::can::CanFrame from_bus(const BusFrame& frame) { return drivers::can::Ca
 
 }  // namespace
 
-std::optional<CanopenQuirks> parse_canopen_quirks(const std::string& names) {
+const std::vector<std::string>& canopen_quirk_names() {
+  static const std::vector<std::string> kNames{"two-tpdo-encoder", "rtr-bit30", "no-type-255", "rpm-units"};
+  return kNames;
+}
+
+std::optional<CanopenQuirks> parse_canopen_quirks(const std::string& names, std::string& error) {
   CanopenQuirks quirks;
+  const CanopenQuirks plain;
   std::size_t at = 0;
   while (at <= names.size()) {
     const std::size_t comma = std::min(names.find(',', at), names.size());
     const std::string name = names.substr(at, comma - at);
     at = comma + 1;
     if (name.empty() || name == "none") continue;
-    if (name == "two-tpdo-encoder") {
-      quirks.two_tpdo_encoder = true;
-    } else if (name == "rtr-bit30") {
-      quirks.rtr_bit30 = true;
-    } else if (name == "no-type-255") {
-      quirks.no_type_255 = true;
-    } else if (name == "rpm-units") {
-      quirks.rpm_units = true;
-    } else {
+    std::string& file = name == "two-tpdo-encoder" ? quirks.encoder_eds : quirks.drive_eds;
+    const std::string& before = name == "two-tpdo-encoder" ? plain.encoder_eds : plain.drive_eds;
+    if (std::find(canopen_quirk_names().begin(), canopen_quirk_names().end(), name) == canopen_quirk_names().end()) {
+      error = "unknown quirk '" + name + "' (" + "two-tpdo-encoder, rtr-bit30, no-type-255, rpm-units)";
       return std::nullopt;
     }
+    if (file != before) {
+      error = "'" + name + "' and another profile both choose the " +
+              (name == "two-tpdo-encoder" ? "encoders'" : "drives'") + " EDS file: one per device";
+      return std::nullopt;
+    }
+    file = name == "two-tpdo-encoder" ? "cdpr-virtual-encoder-two-tpdo.eds"
+                                      : "cdpr-virtual-drive-" + std::string(name == "rpm-units" ? "rpm" : name) + ".eds";
   }
   return quirks;
+}
+
+namespace {
+
+DriveDefaults drive_defaults(const NodeLayout& layout) {
+  constexpr double kPi = 3.14159265358979323846;
+  DriveDefaults drive;
+  drive.eds = layout.drive_eds;
+  if (layout.drive_power_on_mode != 0) {
+    drive.stored[object_key(0x6060, 0)] = static_cast<std::uint8_t>(layout.drive_power_on_mode);
+  }
+  drive.counts_per_rev = kPi * layout.drum_diameter_m / layout.gear_ratio / layout.drive_m_per_count;
+  return drive;
+}
+
+EncoderDefaults encoder_defaults(const NodeLayout& layout) {
+  EncoderDefaults encoder;
+  encoder.eds = layout.encoder_eds;
+  encoder.stored[object_key(0x6002, 0)] = layout.encoder_range_counts;
+  return encoder;
+}
+
+}  // namespace
+
+void CanopenNodes::apply(const CanopenQuirks& quirks, NodeLayout& layout) {
+  layout.drive_eds = shipped_eds(quirks.drive_eds);
+  layout.encoder_eds = shipped_eds(quirks.encoder_eds);
+}
+
+std::string CanopenNodes::check(const NodeLayout& layout) {
+  std::string why = Cia402Device::check(layout.drive_node_id[0], drive_defaults(layout));
+  return why.empty() ? Cia406Device::check(layout.encoder_node_id[0], encoder_defaults(layout)) : why;
 }
 
 CanopenNodes::CanopenNodes(const NodeLayout& layout, RobotPhysics& physics, sim::Rng rng, hal::TimeUs now_us)
     : layout_(layout), physics_(physics), rng_(rng) {
   (void)now_us;
-  DriveDefaults drive;
-  drive.power_on_mode = layout.drive_power_on_mode;
-  EncoderDefaults encoder;
-  encoder.measuring_range = layout.encoder_range_counts;
-  const CanopenQuirks& q = layout.quirks;
-  for (CommunicationQuirks* c : {&drive.quirks, &encoder.quirks}) {
-    c->cob_id_bit30_fixed = q.rtr_bit30;
-    c->no_type_255 = q.no_type_255;
-  }
-  if (q.two_tpdo_encoder) {
-    encoder.quirks.tpdo_count = 2;
-    encoder.quirks.rpdo_count = 0;
-  }
-  if (q.rpm_units) {
-    constexpr double kPi = 3.14159265358979323846;
-    drive.rpm_units = true;
-    drive.counts_per_rev = kPi * layout.drum_diameter_m / layout.gear_ratio / layout.drive_m_per_count;
-  }
+  const DriveDefaults drive = drive_defaults(layout);
+  const EncoderDefaults encoder = encoder_defaults(layout);
   for (int i = 0; i < kCableCount; ++i) {
     drives_[i] = std::make_unique<Cia402Device>(layout.drive_node_id[i], drive);
     drives_[i]->set_initial_position(physics.payout_m(i) / layout.drive_m_per_count);

@@ -30,18 +30,23 @@
 
 namespace cdpr::virtual_robot {
 
-// Vendor quirks the nodes play (docs/fieldbus.md, "Vendor quirks"), as
-// --canopen-quirks names them.
+// The EDS files the nodes play: the shipped virtual devices', or a vendor
+// quirk profile (docs/fieldbus.md, "Vendor quirks") as --canopen-quirks
+// names it, each a shipped EDS file: two-tpdo-encoder (encoders with TPDO1-2
+// only and no RPDO, as Kübler Sendix and SIKO), rtr-bit30 (drives keeping
+// COB-ID bit 30 at 1, Lika), no-type-255 (drives whose transmission types
+// stop at 254, Lika), rpm-units (drives in rpm and rpm/s, maxon EPOS4,
+// Nanotec). "a,b" combines an encoder's profile with a drive's.
 struct CanopenQuirks {
-  bool two_tpdo_encoder = false;  // encoders: TPDO1-2 only, no RPDO (Kübler Sendix, SIKO)
-  bool rtr_bit30 = false;         // every node keeps COB-ID bit 30 at 1 (Lika)
-  bool no_type_255 = false;       // every node refuses transmission type 255 (Lika)
-  bool rpm_units = false;         // drives count 0x6081.. in rpm and rpm/s (maxon EPOS4, Nanotec)
+  std::string drive_eds = "cdpr-virtual-drive.eds";
+  std::string encoder_eds = "cdpr-virtual-encoder.eds";
 };
 
-// "two-tpdo-encoder,rtr-bit30,no-type-255,rpm-units" (any of them, "" or
-// "none": none) -> quirks; nullopt for an unknown name.
-std::optional<CanopenQuirks> parse_canopen_quirks(const std::string& names);
+// names -> the profile's files ("" or "none": the plain ones); nullopt with
+// `error` for an unknown name or two profiles of the same device.
+std::optional<CanopenQuirks> parse_canopen_quirks(const std::string& names, std::string& error);
+// All profiles, one by one (for tests and make demo).
+const std::vector<std::string>& canopen_quirk_names();
 
 struct NodeLayout {
   std::array<int, kCableCount> drive_node_id{1, 2, 3, 4};
@@ -51,8 +56,10 @@ struct NodeLayout {
   std::uint32_t encoder_range_counts = 1u << 26;  // 0x6002: 671 m at 1e-5 m per count
   std::int8_t drive_power_on_mode = 0;            // 0x6060 at power on: 0 none, 1 profile position, 6 homing
   double encoder_noise_m = 0.0;  // 1-sigma per reading [m]
-  CanopenQuirks quirks;
-  // rpm_units: the winch's mechanics the daemon must be told in
+  // What the drives and encoders play: a shipped file by default (quirks), or any other.
+  DeviceEds drive_eds = shipped_eds(CanopenQuirks{}.drive_eds);
+  DeviceEds encoder_eds = shipped_eds(CanopenQuirks{}.encoder_eds);
+  // Drives in rpm: the winch's mechanics the daemon must be told in
   // [winches.mechanics] (motor counts per revolution follow from drive_m_per_count).
   double drum_diameter_m = 0.2;
   double gear_ratio = 10.0;
@@ -60,7 +67,12 @@ struct NodeLayout {
 
 class CanopenNodes {
  public:
+  // Aborts when check(layout) refuses.
   CanopenNodes(const NodeLayout& layout, RobotPhysics& physics, sim::Rng rng, hal::TimeUs now_us);
+  // Empty when the nodes can play the layout's EDS files, else why not.
+  static std::string check(const NodeLayout& layout);
+  // The layout's quirk profile: its drives' and encoders' shipped EDS files.
+  static void apply(const CanopenQuirks& quirks, NodeLayout& layout);
 
   // A frame from the bus (the daemon).
   void on_frame(const drivers::can::CanFrame& frame, hal::TimeUs now_us);

@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
+#include <cstdio>
+#include <utility>
 
 namespace cdpr::virtual_robot {
 namespace {
@@ -17,53 +18,71 @@ constexpr std::uint16_t kBitRelative = 0x0040;
 constexpr std::uint16_t kBitFaultReset = 0x0080;
 constexpr std::uint16_t kBitHalt = 0x0100;
 
-std::uint32_t mapping(std::uint16_t index, std::uint8_t subindex, std::uint8_t bits) {
-  return static_cast<std::uint32_t>(index) << 16 | static_cast<std::uint32_t>(subindex) << 8 | bits;
+constexpr std::uint32_t kRpm = 0x00B44700;  // 0x60A9: 10^0, rpm (CiA 303-2 unit and time codes)
+
+// The objects this drive reads or writes itself.
+struct Played {
+  std::uint16_t index;
+  std::uint8_t subindex;
+  const char* name;
+};
+constexpr Played kPlayed[] = {
+    {0x603F, 0, "error code"},         {0x6007, 0, "abort connection option code"},
+    {0x6040, 0, "controlword"},        {0x6041, 0, "statusword"},
+    {0x605A, 0, "quick stop option code"}, {0x6060, 0, "modes of operation"},
+    {0x6061, 0, "modes of operation display"}, {0x6064, 0, "position actual value"},
+    {0x6065, 0, "following error window"}, {0x607A, 0, "target position"},
+    {0x607D, 1, "min position limit"}, {0x607D, 2, "max position limit"},
+    {0x6081, 0, "profile velocity"},   {0x6083, 0, "profile acceleration"},
+    {0x6084, 0, "profile deceleration"}, {0x6085, 0, "quick stop deceleration"}};
+
+std::string missing_drive_object(const ObjectDictionary& od) {
+  for (const Played& p : kPlayed) {
+    if (od.find(p.index, p.subindex) == nullptr) {
+      char text[96];
+      std::snprintf(text, sizeof(text), "no object 0x%04X:%02X (%s), which the drive plays", p.index, p.subindex, p.name);
+      return text;
+    }
+  }
+  if (const OdEntry* units = od.find(0x60A9, 0); units != nullptr) {
+    if (units->default_value != kRpm) {
+      char text[96];
+      std::snprintf(text, sizeof(text), "0x60A9 = 0x%08X: a velocity unit the drive does not play (rpm only)",
+                    units->default_value);
+      return text;
+    }
+    if (od.find(0x6080, 0) == nullptr) return "no object 0x6080:00 (max motor speed), which a drive in rpm plays";
+  }
+  return CanopenDevice::check_communication_objects(od);
+}
+
+ObjectDictionary drive_dictionary(int node_id, const DriveDefaults& defaults, std::string& error) {
+  ObjectDictionary od = dictionary_from_eds(defaults.eds, node_id, defaults.stored, missing_drive_object, error);
+  if (!error.empty()) return od;
+  // The mode in effect at power on is the stored one.
+  OdEntry* display = od.find(0x6061, 0);
+  display->value = display->default_value = od.get(0x6060, 0);
+  return od;
+}
+
+ObjectDictionary checked_drive_dictionary(int node_id, const DriveDefaults& defaults) {
+  std::string error;
+  ObjectDictionary od = drive_dictionary(node_id, defaults, error);
+  return dictionary_or_abort("Cia402Device", std::move(od), error);
 }
 
 }  // namespace
 
-Cia402Device::Cia402Device(int node_id, const DriveDefaults& defaults)
-    : CanopenDevice(node_id, defaults.identity, defaults.quirks), defaults_(defaults) {
-  ObjectDictionary& d = od();
-  if (defaults.rpm_units) {
-    d.add(0x6080, 0, 4, Access::kReadWrite, false, defaults.max_motor_speed_rpm);
-    d.add(0x60A9, 0, 4, Access::kReadOnly, false, 0x00B44700);  // rpm
-  }
-  d.add(0x603F, 0, 2, Access::kReadOnly, true, 0);
-  d.add(0x6007, 0, 2, Access::kReadWrite, false, 1);
-  d.add(0x6040, 0, 2, Access::kReadWrite, true, 0);
-  d.add(0x6041, 0, 2, Access::kReadOnly, true, 0x0240);
-  d.add(0x605A, 0, 2, Access::kReadWrite, false, 2);
-  d.add(0x6060, 0, 1, Access::kReadWrite, true, static_cast<std::uint8_t>(defaults.power_on_mode));
-  d.add(0x6061, 0, 1, Access::kReadOnly, true, static_cast<std::uint8_t>(defaults.power_on_mode));
-  d.add(0x6064, 0, 4, Access::kReadOnly, true, 0);
-  d.add(0x6065, 0, 4, Access::kReadWrite, false, 0xFFFFFFFF);  // following error window: off
-  d.add(0x607A, 0, 4, Access::kReadWrite, true, 0);
-  d.add(0x607D, 0, 1, Access::kReadOnly, false, 2);
-  d.add(0x607D, 1, 4, Access::kReadWrite, false, static_cast<std::uint32_t>(std::numeric_limits<std::int32_t>::min()));
-  d.add(0x607D, 2, 4, Access::kReadWrite, false, static_cast<std::uint32_t>(std::numeric_limits<std::int32_t>::max()));
-  // The power-on profile in the drive's own units.
-  const double per_count = defaults.rpm_units ? 60.0 / defaults.counts_per_rev : 1.0;
-  const auto own = [per_count](std::uint32_t counts) {
-    return std::max<std::uint32_t>(1, static_cast<std::uint32_t>(std::lround(counts * per_count)));
-  };
-  d.add(0x6081, 0, 4, Access::kReadWrite, true, own(defaults.profile_velocity));
-  d.add(0x6083, 0, 4, Access::kReadWrite, true, own(defaults.acceleration));
-  d.add(0x6084, 0, 4, Access::kReadWrite, true, own(defaults.acceleration));
-  d.add(0x6085, 0, 4, Access::kReadWrite, false, own(defaults.quick_stop_deceleration));
-  const auto id = static_cast<std::uint32_t>(node_id);
-  const std::uint32_t off = 0x80000000u;
-  add_communication_objects(
-      {PdoDefault{0x200 + id, {mapping(0x6040, 0, 16)}},
-       PdoDefault{off | (0x300 + id), {mapping(0x6040, 0, 16), mapping(0x6060, 0, 8)}},
-       PdoDefault{off | (0x400 + id), {mapping(0x6040, 0, 16), mapping(0x607A, 0, 32)}},
-       PdoDefault{off | (0x500 + id), {mapping(0x6040, 0, 16)}}},
-      {PdoDefault{0x180 + id, {mapping(0x6041, 0, 16)}},
-       PdoDefault{off | (0x280 + id), {mapping(0x6041, 0, 16), mapping(0x6061, 0, 8)}},
-       PdoDefault{off | (0x380 + id), {mapping(0x6041, 0, 16), mapping(0x6064, 0, 32)}},
-       PdoDefault{off | (0x480 + id), {mapping(0x6041, 0, 16)}}});
+std::string Cia402Device::check(int node_id, const DriveDefaults& defaults) {
+  std::string error;
+  (void)drive_dictionary(node_id, defaults, error);
+  return error;
 }
+
+Cia402Device::Cia402Device(int node_id, const DriveDefaults& defaults)
+    : CanopenDevice(node_id, checked_drive_dictionary(node_id, defaults)),
+      defaults_(defaults),
+      rpm_units_(od().find(0x60A9, 0) != nullptr) {}
 
 bool Cia402Device::operation_enabled() const { return power_ == Power::kOperationEnabled; }
 
@@ -100,7 +119,7 @@ std::uint32_t Cia402Device::check_write(std::uint16_t index, std::uint8_t subind
     case 0x6085:
       if (value == 0) return abort_code::kInvalidValue;
       // A velocity above the motor's maximum is refused, not clamped (the master must convert).
-      return index == 0x6081 && defaults_.rpm_units && value > od().get(0x6080, 0) ? abort_code::kInvalidValue : 0;
+      return index == 0x6081 && rpm_units_ && value > od().get(0x6080, 0) ? abort_code::kInvalidValue : 0;
     default: return 0;
   }
 }
@@ -250,8 +269,13 @@ void Cia402Device::take_setpoint(hal::TimeUs now_us) {
 }
 
 double Cia402Device::counts_per_s(std::uint16_t index) const {
-  const double value = od().get(index, 0);
-  return defaults_.rpm_units ? value * defaults_.counts_per_rev / 60.0 : value;
+  double value = od().get(index, 0);
+  // The factor group where the EDS has it: internal = written x numerator / divisor.
+  const std::uint16_t factor = index == 0x6081 ? 0x6096 : 0x6097;
+  const OdEntry* numerator = od().find(factor, 1);
+  const OdEntry* divisor = od().find(factor, 2);
+  if (numerator != nullptr && divisor != nullptr && divisor->value != 0) value = value * numerator->value / divisor->value;
+  return rpm_units_ ? value * defaults_.counts_per_rev / 60.0 : value;
 }
 
 bool Cia402Device::brake(double deceleration, double dt_s) {

@@ -24,39 +24,44 @@
 //   0x603F; fault reaction on the quick-stop ramp;
 // - heartbeat consumer loss: reaction per 0x6007 (1 fault, 2 disable
 //   voltage, 3 quick stop), EMCY 0x8130 from CanopenDevice;
-// - velocity units: position increments per second by default (no 0x60A9,
-//   the factor group at its CiA 402 default of 1), or with rpm_units as
-//   maxon EPOS4, Nanotec and Synapticon drives come: 0x60A9 = 0x00B44700
-//   (rpm), profile velocity 0x6081 in rpm, 0x6083/0x6084/0x6085 in rpm/s,
+// - velocity units as its 0x60A9 says: position increments per second
+//   when the EDS has no 0x60A9 (the factor group at its CiA 402 default of
+//   1), or rpm (0x00B44700) as maxon EPOS4, Nanotec and Synapticon drives
+//   come: profile velocity 0x6081 in rpm, 0x6083/0x6084/0x6085 in rpm/s,
 //   max motor speed 0x6080 in rpm (a faster 0x6081 is refused), and
-//   counts_per_rev motor position counts per revolution.
-// Predefined PDOs (CiA 402): RPDO1 = controlword only, TPDO1 = statusword
-// only, the others invalid. Units: position counts, time simulated seconds
-// in advance(). Not thread-safe.
+//   counts_per_rev motor position counts per revolution; a velocity
+//   factor 0x6096 and an acceleration factor 0x6097 where its EDS has them
+//   (internal = written x numerator / divisor);
+// Its objects, their power-on values (the shipped cdpr-virtual-drive.eds:
+// the CiA 402 predefined PDOs, RPDO1 = controlword only, TPDO1 = statusword
+// only, the others invalid), PDO count and ranges come from its EDS.
+// Units: position counts, time simulated seconds in advance(). Not
+// thread-safe.
 
 #include <cstdint>
 
+#include <string>
+
 #include "virtual-robot/canopen_device.h"
+#include "virtual-robot/object_dictionary_eds.h"
 
 namespace cdpr::virtual_robot {
 
 struct DriveDefaults {
-  DeviceIdentity identity{0x00020192, 0x0000CD42, 0x00000402, 1, 0};
-  std::int8_t power_on_mode = 0;             // 0x6060 at power on (1: profile position, 6: homing)
-  std::uint32_t profile_velocity = 100'000;  // 0x6081 at power on [counts/s, in the drive's units]
-  std::uint32_t acceleration = 1'000'000;    // 0x6083, 0x6084 [counts/s^2, likewise]
-  std::uint32_t quick_stop_deceleration = 2'000'000;  // 0x6085 [counts/s^2, likewise]
+  DeviceEds eds = shipped_eds("cdpr-virtual-drive.eds");
+  StoredParameters stored;                   // e.g. 0x6060 = 6: a drive that comes up in homing
   double motor_max_speed = 1e9;              // what the motor can do [counts/s]
   double ack_delay_s = 0.010;                // one PDO cycle [s, real time]
-  bool rpm_units = false;                    // 0x6081.. in rpm and rpm/s (see above)
-  double counts_per_rev = 4096.0;            // rpm_units: motor position counts per revolution
-  std::uint32_t max_motor_speed_rpm = 10'000;  // rpm_units: 0x6080
-  CommunicationQuirks quirks;
+  double counts_per_rev = 4096.0;            // motor position counts per revolution (for rpm)
 };
 
 class Cia402Device final : public CanopenDevice {
  public:
+  // Aborts when check() refuses `defaults`: check files from outside first.
   Cia402Device(int node_id, const DriveDefaults& defaults);
+  // Empty when the drive can play `defaults.eds`, else why not ("<file>: no
+  // object 0x6041:00 (statusword), which the drive plays").
+  static std::string check(int node_id, const DriveDefaults& defaults);
 
   // Moves the axis by dt_s of simulated time.
   void advance(double dt_s);
@@ -99,6 +104,7 @@ class Cia402Device final : public CanopenDevice {
   double counts_per_s(std::uint16_t index) const;
 
   DriveDefaults defaults_;
+  bool rpm_units_ = false;  // 0x60A9 = rpm
   Power power_ = Power::kSwitchOnDisabled;
   std::uint16_t last_controlword_ = 0;
   double demand_ = 0.0;     // profile generator position [counts]

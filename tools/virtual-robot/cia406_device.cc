@@ -1,22 +1,37 @@
 #include "virtual-robot/cia406_device.h"
 
+#include <cstdio>
+#include <utility>
+
 namespace cdpr::virtual_robot {
 
-Cia406Device::Cia406Device(int node_id, const EncoderDefaults& defaults)
-    : CanopenDevice(node_id, defaults.identity, defaults.quirks) {
-  od().add(0x6000, 0, 2, Access::kReadWrite, false, defaults.operating_parameters);  // bit 0: code sequence
-  od().add(0x6001, 0, 4, Access::kReadWrite, false, defaults.counts_per_revolution);
-  od().add(0x6002, 0, 4, Access::kReadWrite, false, defaults.measuring_range);
-  od().add(0x6004, 0, 4, Access::kReadOnly, true, 0);
-  const auto id = static_cast<std::uint32_t>(node_id);
-  const std::uint32_t off = 0x80000000u;
-  PdoDefault tpdo1{0x180 + id, {0x60040020}};
-  add_communication_objects({PdoDefault{off | (0x200 + id), {}}, PdoDefault{off | (0x300 + id), {}},
-                             PdoDefault{off | (0x400 + id), {}}, PdoDefault{off | (0x500 + id), {}}},
-                            {tpdo1, PdoDefault{off | (0x280 + id), {0x60040020}}, PdoDefault{off | (0x380 + id), {}},
-                             PdoDefault{off | (0x480 + id), {}}});
-  od().find(0x1800, 2)->value = od().find(0x1800, 2)->default_value = 254;
+namespace {
+
+std::string missing_encoder_object(const ObjectDictionary& od) {
+  for (const std::uint16_t index : {0x6000, 0x6001, 0x6002, 0x6004}) {
+    if (od.find(index, 0) == nullptr) {
+      char text[64];
+      std::snprintf(text, sizeof(text), "no object 0x%04X:00, which the encoder plays", index);
+      return text;
+    }
+  }
+  return CanopenDevice::check_communication_objects(od);
 }
+
+}  // namespace
+
+std::string Cia406Device::check(int node_id, const EncoderDefaults& defaults) {
+  std::string error;
+  (void)dictionary_from_eds(defaults.eds, node_id, defaults.stored, missing_encoder_object, error);
+  return error;
+}
+
+Cia406Device::Cia406Device(int node_id, const EncoderDefaults& defaults)
+    : CanopenDevice(node_id, [&] {
+        std::string error;
+        ObjectDictionary od = dictionary_from_eds(defaults.eds, node_id, defaults.stored, missing_encoder_object, error);
+        return dictionary_or_abort("Cia406Device", std::move(od), error);
+      }()) {}
 
 std::uint32_t Cia406Device::position_value() const {
   const auto range = static_cast<std::int64_t>(od().get(0x6002, 0));

@@ -2,28 +2,33 @@
 // A simulated CiA 406 linear/rotary encoder on a CanopenDevice: the
 // position value 0x6004 is UNSIGNED32 and wraps at the total measuring
 // range 0x6002 (a position a few counts below zero reads range - few),
-// counting the other way when 0x6000 bit 0 (code sequence) is set;
-// predefined TPDO1 maps 0x6004, transmission type 254 without event timer
-// until the master sets one (then it sends cyclically). Written from the
-// standard, independently of the master. Not thread-safe.
+// counting the other way when 0x6000 bit 0 (code sequence) is set. Its
+// objects and power-on values come from its EDS (the shipped
+// cdpr-virtual-encoder.eds: TPDO1 maps 0x6004, transmission type 254
+// without event timer until the master sets one, then it sends
+// cyclically). Written from the standard, independently of the master.
+// Not thread-safe.
 
 #include <cstdint>
 
+#include <string>
+
 #include "virtual-robot/canopen_device.h"
+#include "virtual-robot/object_dictionary_eds.h"
 
 namespace cdpr::virtual_robot {
 
 struct EncoderDefaults {
-  DeviceIdentity identity{0x00020196, 0x0000CD42, 0x00000406, 1, 0};
-  std::uint32_t measuring_range = 1u << 25;  // 0x6002 [counts]
-  std::uint16_t operating_parameters = 0;     // 0x6000: bit 0 code sequence (1: counts down where 0 counts up)
-  std::uint32_t counts_per_revolution = 4096; // 0x6001
-  CommunicationQuirks quirks;
+  DeviceEds eds = shipped_eds("cdpr-virtual-encoder.eds");
+  StoredParameters stored;  // e.g. 0x6002: another measuring range, 0x6000 = 1: counting the other way
 };
 
 class Cia406Device final : public CanopenDevice {
  public:
+  // Aborts when check() refuses `defaults`: check files from outside first.
   Cia406Device(int node_id, const EncoderDefaults& defaults);
+  // Empty when the encoder can play `defaults.eds`, else why not.
+  static std::string check(int node_id, const EncoderDefaults& defaults);
 
   // The encoder's position from the mechanics [counts, unbounded]; it
   // reports it modulo the measuring range.

@@ -34,7 +34,8 @@ int main(int argc, char** argv) {
   app.add_option("--time-scale", options.time_scale, "simulated seconds per real second (drive speed, settling)")
       ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--endpoints,--dir", options.dir,
-                 "directory for can.sock, pose.sock, clock (the robot's clock: cdpr-calibd --sim-clock), robot.toml, truth.toml and ready (created)")->required();
+                 "directory for can.sock, pose.sock, clock (the robot's clock: cdpr-calibd --sim-clock), robot.toml, truth.toml, "
+                 "drive.eds and encoder.eds (what its CANopen nodes play) and ready (created)")->required();
   app.add_option("--modbus-port", options.modbus_port, "Modbus TCP port on 127.0.0.1; 0: any free port (see ready)")
       ->check(CLI::Range(0, 65535))->capture_default_str();
   std::string transport = "tcp";
@@ -76,14 +77,26 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(-0.9, 10.0));
   std::string quirks = "none";
   app.add_option("--canopen-quirks", quirks,
-                 "vendor quirks the CANopen nodes play, comma-separated: two-tpdo-encoder, rtr-bit30, no-type-255, "
-                 "rpm-units (drum 0.2 m, gear 10: the daemon needs [winches.mechanics]); docs/fieldbus.md")
+                 "vendor quirk profile the CANopen nodes play, each a shipped EDS file: two-tpdo-encoder (encoders), "
+                 "rtr-bit30, no-type-255 or rpm-units (drives; rpm: drum 0.2 m, gear 10, the daemon needs "
+                 "[winches.mechanics]); an encoder's and a drive's comma-separated; docs/fieldbus.md")
       ->check([](const std::string& names) {
-        return cdpr::virtual_robot::parse_canopen_quirks(names) ? std::string() : "unknown quirk in '" + names + "'";
+        std::string error;
+        return cdpr::virtual_robot::parse_canopen_quirks(names, error) ? std::string() : error;
       })
       ->capture_default_str();
+  std::string drive_eds, encoder_eds;
+  app.add_option("--drive-eds", drive_eds, "the EDS file the drives play instead (their object dictionary)");
+  app.add_option("--encoder-eds", encoder_eds, "the EDS file the encoders play instead");
   CLI11_PARSE(app, argc, argv);
-  options.nodes.quirks = *cdpr::virtual_robot::parse_canopen_quirks(quirks);
+  std::string eds_error;
+  cdpr::virtual_robot::CanopenNodes::apply(*cdpr::virtual_robot::parse_canopen_quirks(quirks, eds_error), options.nodes);
+  if (!drive_eds.empty()) options.nodes.drive_eds = cdpr::virtual_robot::read_device_eds(drive_eds, eds_error);
+  if (!encoder_eds.empty()) options.nodes.encoder_eds = cdpr::virtual_robot::read_device_eds(encoder_eds, eds_error);
+  if (!eds_error.empty()) {
+    std::fprintf(stderr, "virtual-robot: %s\n", eds_error.c_str());
+    return 1;
+  }
   options.preset = *cdpr::sim::parse_preset(preset);
   options.report_stops = true;  // a line per stop: how far the platform swung (docs/fieldbus.md)
   options.modbus_rtu = transport == "rtu";

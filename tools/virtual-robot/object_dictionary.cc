@@ -6,13 +6,32 @@ namespace cdpr::virtual_robot {
 
 void ObjectDictionary::add(std::uint16_t index, std::uint8_t subindex, std::uint8_t size, Access access, bool mappable,
                            std::uint32_t value) {
-  entries_.push_back(OdEntry{index, subindex, size, access, mappable, value, value});
+  entries_.push_back(OdEntry{index, subindex, size, access, mappable, value, value, false, std::nullopt, std::nullopt});
 }
 
 void ObjectDictionary::reset(bool communication_only) {
   for (OdEntry& e : entries_) {
     if (!communication_only || (e.index >= 0x1000 && e.index <= 0x1FFF)) e.value = e.default_value;
   }
+}
+
+void ObjectDictionary::set_limits(std::uint16_t index, std::uint8_t subindex, bool is_signed,
+                                  std::optional<std::int64_t> low, std::optional<std::int64_t> high) {
+  OdEntry* e = find(index, subindex);
+  if (e == nullptr) std::abort();
+  e->is_signed = is_signed;
+  e->low = low;
+  e->high = high;
+}
+
+std::uint32_t ObjectDictionary::check_range(const OdEntry& entry, std::uint32_t value) {
+  std::int64_t v = value;
+  if (entry.is_signed && entry.size == 1) v = static_cast<std::int8_t>(value & 0xFF);
+  if (entry.is_signed && entry.size == 2) v = static_cast<std::int16_t>(value & 0xFFFF);
+  if (entry.is_signed && entry.size == 4) v = static_cast<std::int32_t>(value);
+  if (entry.low && v < *entry.low) return abort_code::kValueTooLow;
+  if (entry.high && v > *entry.high) return abort_code::kValueTooHigh;
+  return 0;
 }
 
 OdEntry* ObjectDictionary::find(std::uint16_t index, std::uint8_t subindex) {

@@ -9,6 +9,7 @@
 // Abort codes returned are CiA 301's (0 = success). Not thread-safe.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,8 @@ constexpr std::uint32_t kPdoTooLong = 0x06040042;
 constexpr std::uint32_t kLength = 0x06070010;
 constexpr std::uint32_t kNoSubindex = 0x06090011;
 constexpr std::uint32_t kInvalidValue = 0x06090030;
+constexpr std::uint32_t kValueTooHigh = 0x06090031;
+constexpr std::uint32_t kValueTooLow = 0x06090032;
 constexpr std::uint32_t kDeviceState = 0x08000022;
 }  // namespace abort_code
 
@@ -39,6 +42,8 @@ struct OdEntry {
   bool mappable = false;
   std::uint32_t value = 0;
   std::uint32_t default_value = 0;
+  bool is_signed = false;                 // INTEGER8/16/32: limits compare signed
+  std::optional<std::int64_t> low, high;  // an SDO write outside them is refused
 };
 
 class ObjectDictionary {
@@ -49,6 +54,11 @@ class ObjectDictionary {
   // Every entry back to its default (NMT reset node); with
   // `communication_only`, only 0x1000-0x1FFF (NMT reset communication).
   void reset(bool communication_only);
+  // The range an SDO write must keep to (the EDS's LowLimit/HighLimit).
+  void set_limits(std::uint16_t index, std::uint8_t subindex, bool is_signed, std::optional<std::int64_t> low,
+                  std::optional<std::int64_t> high);
+  // 0 when `value` is within the entry's range, else abort 0x06090031 / 0x06090032.
+  static std::uint32_t check_range(const OdEntry& entry, std::uint32_t value);
 
   OdEntry* find(std::uint16_t index, std::uint8_t subindex);
   const OdEntry* find(std::uint16_t index, std::uint8_t subindex) const;

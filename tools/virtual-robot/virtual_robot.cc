@@ -53,6 +53,7 @@ Eigen::Vector3d start_position_world(sim::Preset preset) {
 
 Expected<std::unique_ptr<VirtualRobot>, std::string> VirtualRobot::create(const VirtualRobotOptions& options) {
   if (!(options.time_scale > 0.0)) return Unexpected{std::string("time scale must be > 0")};
+  if (std::string why = CanopenNodes::check(options.nodes); !why.empty()) return Unexpected{"CANopen nodes: " + why};
   auto data = sim::simulate_dataset(dataset_config(options));
   if (!data) return Unexpected{"simulated robot: " + data.error()};
   auto robot = std::unique_ptr<VirtualRobot>(new VirtualRobot(options, std::move(*data)));
@@ -93,10 +94,13 @@ Expected<std::unique_ptr<VirtualRobot>, std::string> VirtualRobot::create(const 
   }
   robot->publish(now_us);
 
+  // drive.eds, encoder.eds: the EDS files its nodes play, for the daemon's [winches.drive|encoder] eds.
   if (!write_file(options.dir + "/robot.toml", formats::format_robot_toml(robot->data_.nominal)) ||
       !write_file(options.dir + "/truth.toml", formats::format_truth_toml(robot->data_.truth)) ||
+      !write_file(options.dir + "/drive.eds", options.nodes.drive_eds.text) ||
+      !write_file(options.dir + "/encoder.eds", options.nodes.encoder_eds.text) ||
       !write_file(options.dir + "/ready", ready)) {
-    return Unexpected{"cannot write robot.toml, truth.toml or ready in " + options.dir};
+    return Unexpected{"cannot write robot.toml, truth.toml, the EDS files or ready in " + options.dir};
   }
   return robot;
 }

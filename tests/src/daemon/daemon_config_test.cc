@@ -165,6 +165,10 @@ TEST(DaemonConfig, RefusesBadInputNamingLineAndKey) {
       {"robot = \"r\"\n[winches.drive]\nconsumer_heartbeat_ms = 100\n", 3,
        "winches.drive.consumer_heartbeat_ms"},  // not above the master's heartbeat period
       {"robot = \"r\"\n[winches.drive]\nvendor_id = -1\n", 3, "winches.drive.vendor_id"},
+      {"robot = \"r\"\n[winches.drive]\neds = \"/nonexistent/epos4.eds\"\n", 3, "winches.drive.eds"},
+      {"robot = \"r\"\n[[winches.winch]]\n[[winches.winch]]\n[[winches.winch]]\ndrive_eds = \"/nonexistent/x.eds\"\n"
+       "[[winches.winch]]\n",
+       5, "winches.winch[2].drive_eds"},  // the third winch's own EDS cannot be read
   };
   for (const Case& c : cases) {
     // GIVEN a configuration with one mistake WHEN parsed
