@@ -1,0 +1,46 @@
+#pragma once
+// Rests of a simulated robot (tools/sim: the true equilibrium of heavy
+// cables) and a committed calibration of it: the true anchors and offsets
+// with a calibration's typical sigmas, perturbed by those sigmas so the
+// priors are honest.
+
+#include <cstdint>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "sim/dataset.h"
+#include "solver/model/calibration.h"
+
+namespace cdpr::test {
+
+struct SimulatedRests {
+  sim::SimulatedDataset data;
+  Calibration calibration;
+};
+
+inline SimulatedRests simulated_rests(sim::Preset preset, int count, std::uint64_t seed, double anchor_sigma_m = 2e-3,
+                                      double offset_sigma_m = 2e-3) {
+  sim::DatasetConfig config;
+  config.preset = preset;
+  config.pose_count = count;
+  config.seed = seed;
+  auto data = sim::simulate_dataset(config);
+  EXPECT_TRUE(data.has_value());
+  SimulatedRests out{std::move(*data), {}};
+  std::mt19937_64 rng(seed + 1000);
+  std::normal_distribution<double> normal;
+  out.calibration.robot = out.data.nominal.name;
+  for (int i = 0; i < kCableCount; ++i) {
+    WinchCalibration w;
+    w.anchor_sigma = Eigen::Vector3d::Constant(anchor_sigma_m);
+    w.anchor_world = out.data.truth.winches[i].anchor_world +
+                     anchor_sigma_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    w.offset_sigma_m = offset_sigma_m;
+    w.offset_m = out.data.truth.winches[i].offset_m + offset_sigma_m * normal(rng);
+    out.calibration.winches.push_back(w);
+  }
+  return out;
+}
+
+}  // namespace cdpr::test
