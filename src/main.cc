@@ -22,6 +22,7 @@
 #include <CLI/CLI.hpp>
 
 #include "drivers/can/canopen_winch_bank.h"
+#include "drivers/can/listening_winch_bank.h"
 #include "drivers/clock/monotonic_clock.h"
 #include "drivers/clock/shared_clock.h"
 #include "drivers/common/load_cell_reader.h"
@@ -169,6 +170,11 @@ int main(int argc, char** argv) {
     log_line("winches: no EDS for " + plain + " ([winches.drive] / [winches.encoder] eds): configured with the CiA "
              "402/406 defaults (4 PDOs, transmission type 255, increments per second unless 0x60A9 says otherwise)");
   }
+  // Watch mode: the robot's controller owns the bus; the daemon only listens (docs/operation-watch-mode.md).
+  drivers::can::ListeningWinchBank listener(winch_config, config->operation.listen,
+                                            drivers::can::make_can_connector(config->winches.endpoint));
+  hal::WinchBank& bank = config->operation.watch ? static_cast<hal::WinchBank&>(listener) : winches;
+  if (config->operation.watch) log_line("watch mode: listening on the CAN bus, sending nothing");
   drivers::modbus::ModbusLoadCell modbus_load_cell(cell_config, clock);
   // The Modbus transaction (up to response timeout x tries) runs on the
   // reader's thread, never in the 20 ms loop.
@@ -185,7 +191,7 @@ int main(int argc, char** argv) {
   std::signal(SIGPIPE, SIG_IGN);
 
   SdNotifier notifier(monotonic_clock);
-  daemon::DaemonLoop loop(*config, *robot, {winches, load_cell, pose, button.get()}, store, clock, notifier, log_line);
+  daemon::DaemonLoop loop(*config, *robot, {bank, load_cell, pose, button.get()}, store, clock, notifier, log_line);
   if (const hal::Status started = loop.start(); !started.ok()) {
     log_line(started.to_string());
     return 1;

@@ -82,6 +82,10 @@ TEST(VirtualRobotOperation, MovesByItselfRestsAndSlipsOneEncoderOnTime) {
     const double expected_m = robot.physics().payout_m(i) + (i == 1 ? 0.02 : 0.0);
     EXPECT_NEAR(reading_m, expected_m, 2e-3) << "cable " << i;  // within a TPDO of a move
   }
+  // AND the winches hold still through the rest, the load cell says stable
+  for (int k = 0; k < 20; ++k) robot.run_once(1'000);
+  EXPECT_TRUE(robot.nodes().winches_still());
+  EXPECT_LT(robot.physics().tension_unsettled_n(robot.nominal_robot().reference_cable), 1.0);
   EXPECT_EQ(robot.frames_from_clients(), 0u);
   std::filesystem::remove_all(dir);
 }
