@@ -3,6 +3,7 @@
 #include <cmath>
 #include <memory>
 
+#include "solver/operation/joint_prior_factor.h"
 #include "solver/operation/value_prior_factor.h"
 
 namespace cdpr {
@@ -91,16 +92,36 @@ std::optional<EffectParameter> effect_parameter(Effect e, const EffectValues& va
 }
 
 bool add_calibration_variables(Problem& problem, const Calibration& calibration, const std::vector<Effect>& effects,
-                               CalibrationUncertainty uncertainty, std::string* why) {
+                               CalibrationUncertainty uncertainty, std::string* why,
+                               const Eigen::Matrix<double, 4 * kCableCount, 4 * kCableCount>* joint) {
   if (static_cast<int>(calibration.winches.size()) != kCableCount) {
     return fail(why, "the calibration has " + std::to_string(calibration.winches.size()) + " winches");
   }
-  for (int i = 0; i < kCableCount; ++i) {
+  const bool joint_prior = joint && uncertainty == CalibrationUncertainty::kPriors;
+  if (joint_prior) {
+    std::vector<Key> keys;
+    std::vector<int> sizes;
+    Eigen::VectorXd value(4 * kCableCount);
+    for (int i = 0; i < kCableCount; ++i) {
+      problem.add_vector(AnchorKey(i), calibration.winches[i].anchor_world);
+      keys.push_back(AnchorKey(i));
+      sizes.push_back(3);
+      value.segment<3>(3 * i) = calibration.winches[i].anchor_world;
+    }
+    for (int i = 0; i < kCableCount; ++i) {
+      problem.add_vector(OffsetKey(i), Eigen::VectorXd::Constant(1, calibration.winches[i].offset_m));
+      keys.push_back(OffsetKey(i));
+      sizes.push_back(1);
+      value(3 * kCableCount + i) = calibration.winches[i].offset_m;
+    }
+    problem.add_factor(std::make_unique<JointPriorFactor>(keys, sizes, value, *joint));
+  }
+  for (int i = 0; i < kCableCount && !joint_prior; ++i) {
     const WinchCalibration& w = calibration.winches[i];
     add_value(problem, AnchorKey(i), {w.anchor_world.x(), w.anchor_world.y(), w.anchor_world.z()},
               {w.anchor_sigma.x(), w.anchor_sigma.y(), w.anchor_sigma.z()}, uncertainty);
   }
-  for (int i = 0; i < kCableCount; ++i) {
+  for (int i = 0; i < kCableCount && !joint_prior; ++i) {
     const WinchCalibration& w = calibration.winches[i];
     add_value(problem, OffsetKey(i), {w.offset_m}, {w.offset_sigma_m}, uncertainty);
   }

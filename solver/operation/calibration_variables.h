@@ -38,7 +38,10 @@ enum class CalibrationUncertainty {
 // Adds AnchorKey(i), OffsetKey(i) and EffectKey(e) for every effect of
 // `effects` with the calibration's values, as `uncertainty` says. False with
 // *why when an effect's values are missing.
+// With kPriors and `joint` (calibration_covariance.h), the anchors and
+// offsets share one prior of that covariance instead of per-axis sigmas.
 bool add_calibration_variables(Problem& problem, const Calibration& calibration, const std::vector<Effect>& effects,
-                               CalibrationUncertainty uncertainty, std::string* why);
+                               CalibrationUncertainty uncertainty, std::string* why,
+                               const Eigen::Matrix<double, 4 * kCableCount, 4 * kCableCount>* joint = nullptr);
 
 }  // namespace cdpr

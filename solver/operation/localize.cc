@@ -43,7 +43,8 @@ std::optional<LocalizedPose> localize_rest(const Robot& robot, const Calibration
   problem.add_vector(ReferenceForceKey(0), first->reference_force);
   const auto uncertainty =
       options.calibration_priors ? CalibrationUncertainty::kPriors : CalibrationUncertainty::kHeldConstant;
-  if (!add_calibration_variables(problem, calibration, *effects, uncertainty, &problem_why)) {
+  if (!add_calibration_variables(problem, calibration, *effects, uncertainty, &problem_why,
+                                 options.calibration_covariance ? &*options.calibration_covariance : nullptr)) {
     return no_pose(why, problem_why);
   }
   problem.add_factor(make_rest_factor(robot, 0, rest, *effects, options.height_sigma_m));

@@ -33,6 +33,10 @@ struct LocalizeOptions {
   double height_sigma_m = 1e-2;
   // The calibration as priors of its sigmas (true) or exact (false).
   bool calibration_priors = true;
+  // With priors: the joint covariance of the anchors and offsets
+  // (calibration_covariance.h) instead of their per-axis sigmas, which
+  // ignore how their errors cancel along each cable.
+  std::optional<Eigen::Matrix<double, 4 * kCableCount, 4 * kCableCount>> calibration_covariance;
   // Also weight the row's measured pose (its position and orientation sigmas).
   bool use_measured_pose = false;
   int max_iterations = 50;

@@ -2,7 +2,9 @@
 #include <CLI/CLI.hpp>
 
 #include "diagnose_command.h"
+#include "localize_command.h"
 #include "solve_command.h"
+#include "watch_command.h"
 #include "version/version.h"
 
 int main(int argc, char** argv) {
@@ -13,8 +15,14 @@ int main(int argc, char** argv) {
   cdpr::tools::add_solve_command(app, solve_args);
   cdpr::tools::DiagnoseArgs diagnose_args;
   cdpr::tools::add_diagnose_command(app, diagnose_args);
+  cdpr::tools::LocalizeArgs localize_args;
+  cdpr::tools::add_localize_command(app, localize_args);
+  cdpr::tools::WatchArgs watch_args;
+  cdpr::tools::add_watch_command(app, watch_args);
   CLI11_PARSE(app, argc, argv);
   if (app.got_subcommand("solve")) return cdpr::tools::run_solve(solve_args);
   if (app.got_subcommand("diagnose")) return cdpr::tools::run_diagnose(diagnose_args);
+  if (app.got_subcommand("localize")) return cdpr::tools::run_localize(localize_args);
+  if (app.got_subcommand("watch")) return cdpr::tools::run_watch(watch_args);
   return 1;
 }

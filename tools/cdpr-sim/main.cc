@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "rest_mode.h"
 #include "sim/dataset.h"
 #include "src/formats/calibration_toml.h"
 #include "src/formats/robot_toml.h"
@@ -146,6 +147,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--segments", config.segments, "Simpson segments per cable in the equilibrium")
       ->check(CLI::PositiveNumber)->capture_default_str();
+  cdpr::tools::RestModeArgs rest_args;
+  cdpr::tools::add_rest_mode_options(app, rest_args);
   CLI11_PARSE(app, argc, argv);
 
   config.preset = *cdpr::sim::parse_preset(args.preset);
@@ -195,6 +198,15 @@ int main(int argc, char** argv) {
     config.workspace_max = Eigen::Vector3d(values[3], values[4], values[5]);
   }
 
+  if (rest_args.rests > 0) {
+    std::error_code made;
+    std::filesystem::create_directories(args.out_dir, made);
+    if (made) {
+      std::fprintf(stderr, "cdpr-sim: cannot create %s: %s\n", args.out_dir.c_str(), made.message().c_str());
+      return 1;
+    }
+    return cdpr::tools::run_rest_mode(config, rest_args, args.out_dir);
+  }
   const auto data = cdpr::sim::simulate_dataset(config);
   if (!data) {
     std::fprintf(stderr, "cdpr-sim: %s\n", data.error().c_str());

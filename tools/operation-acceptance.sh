@@ -1,0 +1,146 @@
+#!/bin/bash
+# Issue 36's acceptance, offline (tools/operation-acceptance.md): the pose
+# from the cables and the health watch on simulated robots in operation
+# (cdpr-sim --rests), against a calibration cdpr-calib solve made from a
+# calibration data set of the same robot (same seed).
+#
+#   tools/operation-acceptance.sh [BUILD_DIR] [SEEDS] [CLEAN_RESTS]
+#
+# Per preset (large, small) and seed 1..SEEDS (default 10):
+#   calibration  cdpr-sim (35 poses over the whole reachable space, as a
+#                calibration plan spreads them; large: nominal anchors 2 m
+#                off, small 0.5 m) and cdpr-calib solve -> calibration.toml;
+#                the rests then lie in the preset's working box (--workspace
+#                shapes only the calibration poses)
+#   clean        CLEAN_RESTS rests (default 50): cdpr-calib localize against
+#                true_poses.csv (position and orientation error, error/sigma
+#                RMS) and cdpr-calib watch (any alarm is a false one)
+#   slip         2 cm encoder slip on cable seed % 4 from rest 10, 30 rests:
+#                flagged within 10 rests and offset[cable] named; the
+#                offered re-fit's change against the slip
+#   anchor       anchor seed % 4 moved 5 cm (random direction) from rest 10,
+#                60 rests: flagged, anchor[cable] named (or only alike)
+#   payload      +10 % platform mass, centre of mass 2 cm aside, from rest 10,
+#                30 rests: flagged and named load
+# An alarm before rest 10 in a fault run counts as a false alarm too.
+# Both commands get the calibration's joint covariance from its samples
+# (--calibration-samples); LOCALIZE_OPTIONS replaces that for localize
+# (e.g. "--exact-calibration", or " " for the per-axis sigmas).
+set -euo pipefail
+build=${1:-build}
+seeds=${2:-10}
+clean_rests=${3:-50}
+sim=$build/tools/cdpr-sim/cdpr-sim
+calib=$build/tools/cdpr-calib/cdpr-calib
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<"$2" | head -1; }
+
+robot_options() {
+  case $1 in
+    large) echo --preset large --anchor-perturbation 2 --workspace 40,40,5,200,180,35 ;;
+    small) echo --preset small --anchor-perturbation 0.5 --workspace 1.5,0.7,3,11,3.8,22 ;;
+  esac
+}
+
+# watch DIR: the summary line of cdpr-calib watch on DIR's rests.
+watch() {
+  "$calib" watch "$1/robot.toml" "$dir/cal/calibration.toml" "$1/samples.csv" --truth "$1/truth_after.toml" \
+    --calibration-samples "$dir/cal/samples.csv" |
+    grep '^summary:' || true
+}
+
+for preset in large small; do
+  mass=$([[ $preset == large ]] && echo 3.4 || echo 0.44)
+  loc_rows=0 pos_sq=0 rot_sq=0 z_sq=0 pos_max=0 rot_max=0
+  clean_total=0 false_alarms=0
+  slip_ok=0 slip_delay="" refit_err_max=0 anchor_named=0 anchor_alike=0 anchor_flagged=0 payload_named=0
+  for seed in $(seq 1 "$seeds"); do
+    dir=$work/$preset-$seed
+    opts=$(robot_options "$preset")
+    # shellcheck disable=SC2086
+    "$sim" $opts --seed "$seed" --out "$dir/cal" >/dev/null
+    "$calib" solve -q "$dir/cal/robot.toml" "$dir/cal/samples.csv" -o "$dir/cal/calibration.toml" >/dev/null 2>&1 || true
+    [[ -f $dir/cal/calibration.toml ]] || { echo "$preset seed $seed: no calibration"; continue; }
+    cable=$((seed % 4))
+
+    # shellcheck disable=SC2086
+    "$sim" $opts --seed "$seed" --rests "$clean_rests" --out "$dir/clean" >/dev/null
+    # shellcheck disable=SC2086
+    line=$("$calib" localize "$dir/clean/robot.toml" "$dir/cal/calibration.toml" "$dir/clean/samples.csv" \
+      --true-poses "$dir/clean/true_poses.csv" -o "$dir/clean/poses.csv" \
+      ${LOCALIZE_OPTIONS:---calibration-samples $dir/cal/samples.csv} 2>&1 |
+      grep '^against' || true)
+    rows=$(field rows "$line")
+    if [[ -n $rows ]]; then
+      read -r loc_rows pos_sq rot_sq z_sq pos_max rot_max < <(awk -v n="$loc_rows" -v ps="$pos_sq" -v rs="$rot_sq" \
+        -v zs="$z_sq" -v pm="$pos_max" -v rm="$rot_max" -v r="$rows" -v p="$(field position_rms_m "$line")" \
+        -v o="$(field orientation_rms_rad "$line")" -v z="$(field error_over_sigma_rms "$line")" \
+        -v px="$(field position_max_m "$line")" -v ox="$(field orientation_max_rad "$line")" \
+        'BEGIN { print n + r, ps + r * p * p, rs + r * o * o, zs + r * z * z, (px > pm ? px : pm), (ox > rm ? ox : rm) }')
+    fi
+    summary=$(watch "$dir/clean")
+    clean_total=$((clean_total + clean_rests))
+    [[ $(field stale "$summary") == 1 ]] && false_alarms=$((false_alarms + 1)) &&
+      echo "$preset seed $seed: false alarm on clean rests: $summary"
+
+    # shellcheck disable=SC2086
+    "$sim" $opts --seed "$seed" --rests 30 --fault slip --fault-cable $cable --fault-size 0.02 --fault-from 10 \
+      --out "$dir/slip" >/dev/null
+    summary=$(watch "$dir/slip")
+    fired=$(field fired_rest "$summary")
+    term=$(field term "$summary")
+    if [[ -n $fired && $fired -lt 10 ]]; then
+      false_alarms=$((false_alarms + 1))
+      echo "$preset seed $seed: alarm before the slip: $summary"
+    elif [[ -n $fired && $((fired - 10 + 1)) -le 10 && $term == "offset[$cable]" ]]; then
+      slip_ok=$((slip_ok + 1))
+    else
+      echo "$preset seed $seed slip on cable $cable: $summary"
+    fi
+    [[ -n $fired ]] && slip_delay="$slip_delay $((fired - 10 + 1))"
+    delta=$(field refit_delta_m "$summary")
+    if [[ -n $delta ]]; then
+      refit_err_max=$(awk -v d="$delta" -v m="$refit_err_max" 'BEGIN { e = d - 0.02; e = e < 0 ? -e : e; print (e > m ? e : m) }')
+    fi
+
+    # shellcheck disable=SC2086
+    "$sim" $opts --seed "$seed" --rests 70 --fault anchor --fault-cable $cable --fault-size 0.05 --fault-from 10 \
+      --out "$dir/anchor" >/dev/null
+    summary=$(watch "$dir/anchor")
+    fired=$(field fired_rest "$summary")
+    if [[ -n $fired && $fired -ge 10 ]]; then
+      anchor_flagged=$((anchor_flagged + 1))
+      if [[ $(field term "$summary") == "anchor[$cable]" ]]; then
+        anchor_named=$((anchor_named + 1))
+      elif [[ $(field alike "$summary") == *"anchor[$cable]"* ]]; then
+        anchor_alike=$((anchor_alike + 1))
+        echo "$preset seed $seed anchor $cable: alike only: $summary"
+      else
+        echo "$preset seed $seed anchor $cable: $summary"
+      fi
+    else
+      [[ -n $fired ]] && false_alarms=$((false_alarms + 1))
+      echo "$preset seed $seed anchor $cable: $summary"
+    fi
+
+    # shellcheck disable=SC2086
+    "$sim" $opts --seed "$seed" --rests 30 --fault payload --fault-size "$mass" --fault-com 0.02,0,0 \
+      --fault-from 10 --out "$dir/payload" >/dev/null
+    summary=$(watch "$dir/payload")
+    fired=$(field fired_rest "$summary")
+    if [[ -n $fired && $fired -ge 10 && $(field term "$summary") == load ]]; then
+      payload_named=$((payload_named + 1))
+    else
+      [[ -n $fired && $fired -lt 10 ]] && false_alarms=$((false_alarms + 1))
+      echo "$preset seed $seed payload: $summary"
+    fi
+  done
+  awk -v p="$preset" -v n="$loc_rows" -v ps="$pos_sq" -v rs="$rot_sq" -v zs="$z_sq" -v pm="$pos_max" -v rm="$rot_max" \
+    'BEGIN { if (n > 0) printf "%s localization: %d rests, position error RMS %.4f m (max %.4f), orientation RMS %.5f rad (max %.5f), error/sigma RMS %.2f\n", p, n, sqrt(ps / n), pm, sqrt(rs / n), rm, sqrt(zs / n) }'
+  echo "$preset slip 2 cm: flagged within 10 rests with the right cable $slip_ok/$seeds; rests to flag:$slip_delay; re-fit change off the slip by at most ${refit_err_max} m"
+  echo "$preset anchor 5 cm: flagged $anchor_flagged/$seeds, named anchor $anchor_named/$seeds, alike only $anchor_alike/$seeds"
+  echo "$preset payload +10 %: named load $payload_named/$seeds"
+  echo "$preset false alarms: $false_alarms (clean rests $clean_total, plus 10 before each fault)"
+done
