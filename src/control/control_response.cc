@@ -163,6 +163,25 @@ Json operation_json(const operation::OperationStatus* operation, hal::TimeUs now
     last["onboard_sigmas"] = o.last->onboard_sigmas;
     json["last_rest"] = std::move(last);
   }
+  if (!o.finding) {
+    json["finding"] = nullptr;
+  } else {
+    const operation::FindingSummary& f = *o.finding;
+    Json finding;
+    finding["term"] = f.term;
+    finding["meaning"] = f.meaning;
+    finding["cable"] = f.cable;
+    finding["value"] = f.value;
+    finding["sigma"] = f.sigma;
+    finding["since_rest"] = f.since_rest;
+    finding["fired_at_rest"] = f.fired_at_rest;
+    finding["fired_s_ago"] = 1e-6 * static_cast<double>(now_us - f.fired_us);
+    finding["rests_fitted"] = f.rests_fitted;
+    finding["calibration_fault"] = f.calibration_fault;
+    finding["alike"] = string_array(f.alike);
+    json["finding"] = std::move(finding);
+  }
+  json["refit"] = o.refit;
   return json;
 }
 

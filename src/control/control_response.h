@@ -34,9 +34,15 @@
 //            not watching: {"mode":"watch","state":"watching","calibration_seq":4,"rests":12,
 //            "localized":12,"detail":"at rest","last_problem":"",
 //            "last_rest":{"rest":12,"age_s":3.1,"position":[x,y,z],"position_sigma":[..],
-//            "orientation_sigma":[..],"onboard_sigmas":1.2}}: state "no calibration",
+//            "orientation_sigma":[..],"onboard_sigmas":1.2},
+//            "finding":{"term":"offset[2]","meaning":"encoder offset slip of cable 2","cable":2,
+//            "value":[0.021],"sigma":[0.002],"since_rest":7,"fired_at_rest":9,"fired_s_ago":40.5,
+//            "rests_fitted":3,"calibration_fault":true,"alike":[]},
+//            "refit":"kept in pending/ for `calibctl commit` (...)"}: state "no calibration",
 //            "waiting for a rest", "watching" or "calibration stale"; last_rest null before the
-//            first rest localized from the cables
+//            first rest localized from the cables; finding null until the health test fires
+//            (solver/operation/health_watch.h: term names and units); refit what became of the
+//            offered re-fit ("" before)
 //   show     {"ok":true,"present":true,"seq":4,"created":"2026-11-22T10:15:00Z","robot":"large",
 //             "model":["catenary"],"samples":35,
 //             "winches":[{"anchor":[x,y,z],"anchor_sigma":[..],"offset":3.2,"offset_sigma":0.03},...],

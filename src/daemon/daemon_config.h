@@ -75,8 +75,8 @@ struct OperationConfig {
   // windows (a production rest is seconds, a calibration waypoint's minutes).
   hal::TimeUs rest_window_us = 2'000'000;
   hal::TimeUs return_window_us = 6'000'000;
-  // Sequential test: the designed false-alarm rate per rest (health watch).
-  double false_alarm_per_rest = 1e-4;
+  // Health watch: the designed false-alarm rate, one per this many clean rests.
+  double clean_rests_per_false_alarm = 1000.0;
   drivers::can::ListenLayout listen;
 };
 

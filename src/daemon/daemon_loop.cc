@@ -219,6 +219,7 @@ void DaemonLoop::step_watch(hal::TimeUs now_us) {
     watched_seq_ = seq;
   }
   watch_->step(devices_, now_us);
+  if (watch_->take_pending_offered()) machine_->refresh_store_problems();  // status: pending_commit
 }
 
 void DaemonLoop::service_idle_devices(hal::TimeUs now_us) {

@@ -22,9 +22,10 @@ Table<OperationConfig> operation_table() {
   t.duration("return_window_s", &OperationConfig::return_window_us, 6.0, kS, {0.2, 3600},
              "watch: how far back a rest must not have come back from a sway; the shortest rest seen is this long")
       .why("at least two rest windows make sense; an hour is longer than any rest");
-  t.number("false_alarm_per_rest", &OperationConfig::false_alarm_per_rest, 1e-4, {0.0, 0.1, true, false}, "",
-           "watch: designed probability that a clean rest raises `calibration stale` (the sequential test's threshold)")
-      .why("above 0.1 every tenth rest would be an alarm");
+  t.number("clean_rests_per_false_alarm", &OperationConfig::clean_rests_per_false_alarm, 1000.0, {10.0, 1e9}, "",
+           "watch: the health test's designed false-alarm rate, at most one `calibration stale` per this many rests "
+           "of a right calibration (its CUSUM threshold, solver/operation/health_watch.h)")
+      .why("below 10 every few rests would be an alarm; beyond 1e9 a change is never flagged");
   t.integer("drive_tpdo_base", [](auto& c) -> auto& { return c.listen.drive_tpdo_base; }, 0x180, {0x080, 0x680, true},
             "", "watch: the drives' TPDO with statusword and position is this + node id (CiA 402 TPDO1: 0x180)")
       .why("node ids up to 127 on top must stay within 0x7FF");

@@ -35,15 +35,21 @@ class WatchService {
   // Reads the committed calibration again (after a commit or a rollback).
   void reload_calibration();
   const operation::OperationStatus& status() const { return watch_.status(); }
+  // True once after a re-fit was put into pending/ (the owner refreshes the machine's view of the store).
+  bool take_pending_offered();
 
  private:
   void on_rest(const operation::RestOutcome& outcome);
+  // The test has just fired: logs the finding, keeps the re-fit in pending/.
+  void offer_refit();
+  void log_finding();
 
   const DaemonConfig& config_;
   store::CalibrationStore& store_;
   std::function<void(const std::string&)> log_;
   operation::OperationWatch watch_;
   std::unique_ptr<PoseOutputServer> output_;
+  bool pending_offered_ = false;
 };
 
 }  // namespace cdpr::daemon

@@ -1,20 +1,27 @@
 #pragma once
 // Watch mode's logic (docs/operation-watch-mode.md), apart from the OS
 // wiring (src/daemon/watch_service.h): rests found by RestWatch, each
-// localized from the cables with the committed calibration
-// (solver/operation/localize.h, the calibration as priors), and compared
-// with the onboard pose in the localization's own covariance plus the
-// onboard pose's sigmas. The status is what `calibctl status` shows under
-// "operation".
-// Time passed in; the localization runs inside step() (a small problem,
-// milliseconds). Not thread-safe.
+// checked by the health watch against the committed calibration
+// (solver/operation/health_watch.h: the pose from the cables with its
+// covariance, the sequential change test per term), the pose compared
+// with the onboard pose in the summed covariances. When the test fires the
+// state is "calibration stale" with the finding, and the re-fit from the
+// rests since the change's onset (solver/operation/refit.h) is offered:
+// handed to the owner, never applied here. The status is what
+// `calibctl status` shows under "operation".
+// Time passed in; the check runs inside step() (a small problem per rest;
+// the re-fit once, when the test fires). Not thread-safe.
 
+#include <memory>
 #include <optional>
+#include <vector>
 #include <string>
 
 #include "solver/model/calibration.h"
 #include "solver/model/robot.h"
+#include "solver/operation/health_watch.h"
 #include "solver/operation/localize.h"
+#include "solver/operation/refit.h"
 #include "src/operation/rest_watch.h"
 
 namespace cdpr::operation {
@@ -31,6 +38,20 @@ struct LocalizedRestSummary {
   double onboard_sigmas = 0.0;
 };
 
+// What the health test found (health_watch.h StaleFinding), for the status.
+struct FindingSummary {
+  std::string term;      // the catalogue's name: "offset[2]", "anchor[1]", "encoder_scale[0]", "load", ...
+  std::string meaning;   // "encoder offset slip of cable 2"
+  int cable = -1;
+  std::vector<double> value, sigma;  // the term's size and its sigma (units: health_watch.h)
+  int since_rest = 0;      // the change's onset
+  int fired_at_rest = 0;
+  hal::TimeUs fired_us = -1;
+  int rests_fitted = 0;
+  bool calibration_fault = true;  // false: load or centre of mass changed (no calibration fault)
+  std::vector<std::string> alike;  // other terms that explain it almost as well
+};
+
 struct OperationStatus {
   // "no calibration" (nothing committed to check against), "waiting for a
   // rest", "watching" (the last rest agreed), "calibration stale" (the
@@ -42,6 +63,9 @@ struct OperationStatus {
   std::string last_problem; // why the last rest could not be localized ("" when it was)
   std::string detail;       // the rest detector's verdict now
   std::optional<LocalizedRestSummary> last;
+  std::optional<FindingSummary> finding;
+  // The offered re-fit: "kept in pending/ for `calibctl commit`", or why none is offered.
+  std::string refit;
 };
 
 // One rest and what became of it.
@@ -54,21 +78,28 @@ struct RestOutcome {
 class OperationWatch {
  public:
   OperationWatch(const Robot& robot, const calibration::EquilibriumThresholds& thresholds, std::size_t capacity,
-                 const LocalizeOptions& localize);
+                 const HealthWatchOptions& health);
 
   // The calibration to check against (none: nothing committed); counts start over.
   void set_calibration(int seq, std::optional<Calibration> calibration);
   std::optional<RestOutcome> step(const WatchReadings& readings, hal::TimeUs now_us);
+  // Once, when the test has just fired: the re-fit to offer (empty with
+  // *why when the rests cannot carry it) and the rests it used.
+  bool refit_due() const { return refit_due_; }
+  std::optional<Calibration> take_refit(std::vector<Sample>& rests, std::string* why);
   const OperationStatus& status() const { return status_; }
   OperationStatus& mutable_status() { return status_; }
   const std::optional<Calibration>& calibration() const { return calibration_; }
 
  private:
+  void note_finding(const StaleFinding& finding, hal::TimeUs now_us);
+
   Robot robot_;
-  LocalizeOptions localize_;
+  HealthWatchOptions health_options_;
   RestWatch rests_;
   std::optional<Calibration> calibration_;
-  std::optional<Pose> previous_;  // the last localized pose: the next start
+  std::unique_ptr<HealthWatch> health_;  // of calibration_
+  bool refit_due_ = false;
   OperationStatus status_;
 };
 

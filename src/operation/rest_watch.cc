@@ -14,6 +14,7 @@ std::optional<WatchedRest> RestWatch::step(const WatchReadings& r, hal::TimeUs n
   if (!complete) {
     detector_.reset();
     last_pose_us_ = -1;
+    settled_since_us_ = -1;
     check_ = {};
     return std::nullopt;
   }
@@ -33,8 +34,12 @@ std::optional<WatchedRest> RestWatch::step(const WatchReadings& r, hal::TimeUs n
     armed_ = true;
     return std::nullopt;
   }
+  if (!check_.settled()) settled_since_us_ = -1;
   if (!armed_ || !check_.settled()) return std::nullopt;
+  if (settled_since_us_ < 0) settled_since_us_ = o.time_us;
+  if (o.time_us - settled_since_us_ < 2 * detector_.thresholds().window_us) return std::nullopt;
   armed_ = false;
+  settled_since_us_ = -1;
   WatchedRest rest;
   rest.index = ++rests_;
   rest.seen_us = now_us;

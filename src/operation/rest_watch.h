@@ -5,7 +5,11 @@
 // equilibrium detector (src/calibration/equilibrium_detector.h, its
 // thresholds and window as configured); the first settled verdict after a
 // motion is one rest, whose window average is a sample row with its own
-// sigmas, as a calibration run takes it. Then nothing more until the
+// sigmas, as a calibration run takes it, once the verdict has stayed
+// settled for two rest windows more (source time): a platform still
+// creeping towards its rest under the rate thresholds would otherwise give
+// a window whose pose and encoders disagree by millimetres, many sigmas of
+// the health test. Then nothing more until the
 // platform moves again (a verdict of motion, kMoving or kRotating): a
 // long rest is one rest, not one per step.
 // A step without a valid pose, payout or tension starts the window over.
@@ -60,6 +64,7 @@ class RestWatch {
   calibration::EquilibriumCheck check_;
   hal::TimeUs last_pose_us_ = -1;  // source stamp of the last pose added
   bool armed_ = true;              // the next settled verdict is a new rest
+  hal::TimeUs settled_since_us_ = -1;  // source time the verdict turned settled; -1: not settled
   int rests_ = 0;
 };
 

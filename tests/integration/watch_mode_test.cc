@@ -104,5 +104,50 @@ TEST(WatchMode, SendsNoFrameWhileItSeesRestsAndServesTheirPoseFromTheCables) {
   EXPECT_EQ(rig.robot->frames_from_clients(), 0u) << "frames the watching daemon sent on the CAN bus";
 }
 
+TEST(WatchMode, AnEncoderSlipMakesTheCalibrationStaleNamingTheCableAndCommitsNothingByItself) {
+  // GIVEN the robot in operation whose encoder 1 slips by 2 cm after 150 s
+  // of its time, the true geometry committed, the daemon watching
+  virtual_robot::VirtualRobotOptions options = operating_robot_options(5);
+  std::string why;
+  options.faults.push_back(*virtual_robot::parse_operation_fault("slip@150:cable=1,size=0.02", why));
+  WatchRig rig(options);
+
+  // WHEN the controller's jobs go on
+  calibctl::JsonValue status;
+  const bool stale = wait_until_robot(
+      rig.robot->clock(),
+      [&] {
+        status = rig.ask("status");
+        return status["operation"]["state"].string() == "calibration stale" &&
+               !status["operation"]["refit"].string().empty();
+      },
+      std::chrono::seconds(150));  // 1500 s of its simulated time at x10
+
+  // THEN the status says stale, names the slipped encoder's offset, offers
+  // the re-fit as a pending calibration, and nothing was committed
+  ASSERT_TRUE(stale) << "operation: state " << status["operation"]["state"].string() << ", rests "
+                     << status["operation"]["rests"].integer() << ", last problem "
+                     << status["operation"]["last_problem"].string();
+  const calibctl::JsonValue finding = status["operation"]["finding"];
+  EXPECT_EQ(finding["term"].string(), "offset[1]") << finding["meaning"].string();
+  EXPECT_EQ(finding["cable"].integer(), 1);
+  EXPECT_TRUE(finding["calibration_fault"].boolean());
+  EXPECT_NEAR(finding["value"].array().at(0).number(), 0.02, 0.01);
+  EXPECT_NE(status["operation"]["refit"].string().find("pending"), std::string::npos)
+      << status["operation"]["refit"].string();
+  EXPECT_TRUE(status["pending_commit"].boolean());
+  const auto current = rig.store->load_current();
+  ASSERT_TRUE(current && *current);
+  EXPECT_EQ((*current)->seq, 1) << "committed by itself";
+  // AND the operator's `commit` commits the offered re-fit, and the watch checks against it
+  const calibctl::JsonValue committed = rig.ask("commit");
+  EXPECT_TRUE(committed["ok"].boolean()) << committed["error"].string();
+  EXPECT_TRUE(wait_until_robot(
+      rig.robot->clock(), [&] { return rig.ask("status")["operation"]["calibration_seq"].integer() == 2; },
+      std::chrono::seconds(10)));
+  rig.stop_daemon();
+  EXPECT_EQ(rig.robot->frames_from_clients(), 0u);
+}
+
 }  // namespace
 }  // namespace cdpr::integration
