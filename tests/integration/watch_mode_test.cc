@@ -100,6 +100,18 @@ TEST(WatchMode, SendsNoFrameWhileItSeesRestsAndServesTheirPoseFromTheCables) {
     EXPECT_EQ(covariance->source_time_us, pose.source_time_us);
     EXPECT_GT(covariance->covariance(0, 0), 0.0);
   }
+  // AND a start without the hand-over fails at the enable, still without a frame
+  EXPECT_TRUE(rig.ask("start")["ok"].boolean());
+  calibctl::JsonValue after;
+  EXPECT_TRUE(wait_until_robot(
+      rig.robot->clock(),
+      [&] {
+        after = rig.ask("status");
+        return after["state"].string() == "failed";
+      },
+      std::chrono::seconds(60)))
+      << after["state"].string() << ": " << after["detail"].string();
+  EXPECT_NE(after["reason"].string().find("controller owns the drives"), std::string::npos) << after["reason"].string();
   rig.stop_daemon();
   EXPECT_EQ(rig.robot->frames_from_clients(), 0u) << "frames the watching daemon sent on the CAN bus";
 }
