@@ -11,10 +11,15 @@
 // systemd can restart it; a device that is not there yet is not a startup
 // failure (the loop reconnects, and preflight refuses to calibrate without
 // it).
+#include <sys/uio.h>
 #include <systemd/sd-daemon.h>
+#include <systemd/sd-journal.h>
 
 #include <atomic>
 #include <csignal>
+#include <cstdlib>
+#include <sstream>
+#include <vector>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -44,7 +49,26 @@ using namespace cdpr;
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop.store(true); }
 
+// A line whose tail after " | " is KEY=value words (watch mode's finding,
+// src/daemon/watch_service.cc) goes to the journal with those as its
+// fields when stderr is the journal (JOURNAL_STREAM); the text before is
+// the MESSAGE. Anything else, and outside systemd, is a plain stderr line.
+bool journal_with_fields(const std::string& text) {
+  const std::size_t bar = text.find(" | ");
+  if (bar == std::string::npos || std::getenv("JOURNAL_STREAM") == nullptr) return false;
+  std::vector<std::string> fields{"MESSAGE=cdpr-calibd: " + text.substr(0, bar), "SYSLOG_IDENTIFIER=cdpr-calibd"};
+  std::istringstream words(text.substr(bar + 3));
+  for (std::string word; words >> word;) {
+    if (word.find('=') == std::string::npos) return false;
+    fields.push_back(word);
+  }
+  std::vector<iovec> vectors;
+  for (std::string& field : fields) vectors.push_back({field.data(), field.size()});
+  return sd_journal_sendv(vectors.data(), static_cast<int>(vectors.size())) >= 0;
+}
+
 void log_line(const std::string& text) {
+  if (journal_with_fields(text)) return;
   std::fprintf(stderr, "cdpr-calibd: %s\n", text.c_str());
   std::fflush(stderr);
 }
