@@ -5,7 +5,6 @@
 #include <fstream>
 #include <sstream>
 
-#include "solver/operation/calibration_covariance.h"
 #include "solver/operation/localize.h"
 #include "solver/operation/rest_problem.h"
 #include "src/formats/samples_csv.h"
@@ -83,19 +82,9 @@ int run_localize(const LocalizeArgs& args) {
   LocalizeOptions options;
   options.calibration_priors = !args.exact_calibration;
   options.height_sigma_m = args.height_sigma_m;
-  if (!args.calibration_samples_path.empty()) {
-    auto samples = formats::read_samples_csv(args.calibration_samples_path, in->robot.cable_count());
-    if (!samples) {
-      std::fprintf(stderr, "cdpr-calib: %s\n", samples.error().message().c_str());
-      return 1;
-    }
-    std::string why;
-    options.calibration_covariance =
-        calibration_covariance(in->robot, in->calibration, *samples, args.height_sigma_m, &why);
-    if (!options.calibration_covariance) {
-      std::fprintf(stderr, "cdpr-calib: %s: %s\n", args.calibration_samples_path.c_str(), why.c_str());
-      return 1;
-    }
+  if (!args.calibration_samples_path.empty() &&
+      !read_calibration_covariance(args.calibration_samples_path, *in, args.height_sigma_m, options.calibration_covariance)) {
+    return 1;
   }
 
   std::ostringstream out;

@@ -39,4 +39,17 @@ std::optional<OperationInputs> read_operation_inputs(const OperationPaths& paths
   return OperationInputs{std::move(*robot), std::move(*calibration), std::move(*rests)};
 }
 
+bool read_calibration_covariance(const std::string& samples_path, const OperationInputs& in, double height_sigma_m,
+                                 std::optional<CalibrationCovariance>& out) {
+  auto samples = formats::read_samples_csv(samples_path, in.robot.cable_count());
+  if (!samples) {
+    std::fprintf(stderr, "cdpr-calib: %s\n", samples.error().message().c_str());
+    return false;
+  }
+  std::string why;
+  out = calibration_covariance(in.robot, in.calibration, *samples, height_sigma_m, &why);
+  if (!out) std::fprintf(stderr, "cdpr-calib: %s: %s\n", samples_path.c_str(), why.c_str());
+  return out.has_value();
+}
+
 }  // namespace cdpr::tools

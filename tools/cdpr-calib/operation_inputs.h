@@ -12,6 +12,7 @@
 #include "solver/model/calibration.h"
 #include "solver/model/robot.h"
 #include "solver/model/sample.h"
+#include "solver/operation/calibration_covariance.h"
 
 namespace cdpr::tools {
 
@@ -28,5 +29,11 @@ struct OperationInputs {
 void add_operation_inputs(CLI::App& command, OperationPaths& paths);
 // Empty after printing the problem (file, line, key) on stderr.
 std::optional<OperationInputs> read_operation_inputs(const OperationPaths& paths);
+
+// The joint covariance of the calibration's anchors and offsets from the
+// samples.csv it was fitted on (--calibration-samples); false after
+// printing why not.
+bool read_calibration_covariance(const std::string& samples_path, const OperationInputs& in, double height_sigma_m,
+                                 std::optional<CalibrationCovariance>& out);
 
 }  // namespace cdpr::tools

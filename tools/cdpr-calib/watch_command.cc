@@ -5,11 +5,9 @@
 #include <fstream>
 
 #include "report.h"
-#include "solver/operation/calibration_covariance.h"
 #include "solver/operation/health_watch.h"
 #include "solver/operation/refit.h"
 #include "src/formats/calibration_toml.h"
-#include "src/formats/samples_csv.h"
 
 namespace cdpr::tools {
 namespace {
@@ -100,19 +98,9 @@ int run_watch(const WatchArgs& args) {
   HealthWatchOptions options;
   options.clean_rests_per_false_alarm = args.clean_rests_per_false_alarm;
   options.use_measured_pose = !args.no_measured_pose;
-  if (!args.calibration_samples_path.empty()) {
-    auto samples = formats::read_samples_csv(args.calibration_samples_path, in->robot.cable_count());
-    if (!samples) {
-      std::fprintf(stderr, "cdpr-calib: %s\n", samples.error().message().c_str());
-      return 1;
-    }
-    std::string why;
-    options.calibration_covariance =
-        calibration_covariance(in->robot, in->calibration, *samples, options.height_sigma_m, &why);
-    if (!options.calibration_covariance) {
-      std::fprintf(stderr, "cdpr-calib: %s: %s\n", args.calibration_samples_path.c_str(), why.c_str());
-      return 1;
-    }
+  if (!args.calibration_samples_path.empty() &&
+      !read_calibration_covariance(args.calibration_samples_path, *in, options.height_sigma_m, options.calibration_covariance)) {
+    return 1;
   }
   HealthWatch watch(in->robot, in->calibration, options);
   std::printf("health watch: %zu rests, threshold h = %.2f (at most one false alarm per %g clean rests)\n",
