@@ -11,10 +11,15 @@
 // systemd can restart it; a device that is not there yet is not a startup
 // failure (the loop reconnects, and preflight refuses to calibrate without
 // it).
+#include <sys/uio.h>
 #include <systemd/sd-daemon.h>
+#include <systemd/sd-journal.h>
 
 #include <atomic>
 #include <csignal>
+#include <cstdlib>
+#include <sstream>
+#include <vector>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -22,6 +27,7 @@
 #include <CLI/CLI.hpp>
 
 #include "drivers/can/canopen_winch_bank.h"
+#include "drivers/can/listening_winch_bank.h"
 #include "drivers/clock/monotonic_clock.h"
 #include "drivers/clock/shared_clock.h"
 #include "drivers/common/load_cell_reader.h"
@@ -43,7 +49,26 @@ using namespace cdpr;
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop.store(true); }
 
+// A line whose tail after " | " is KEY=value words (watch mode's finding,
+// src/daemon/watch_service.cc) goes to the journal with those as its
+// fields when stderr is the journal (JOURNAL_STREAM); the text before is
+// the MESSAGE. Anything else, and outside systemd, is a plain stderr line.
+bool journal_with_fields(const std::string& text) {
+  const std::size_t bar = text.find(" | ");
+  if (bar == std::string::npos || std::getenv("JOURNAL_STREAM") == nullptr) return false;
+  std::vector<std::string> fields{"MESSAGE=cdpr-calibd: " + text.substr(0, bar), "SYSLOG_IDENTIFIER=cdpr-calibd"};
+  std::istringstream words(text.substr(bar + 3));
+  for (std::string word; words >> word;) {
+    if (word.find('=') == std::string::npos) return false;
+    fields.push_back(word);
+  }
+  std::vector<iovec> vectors;
+  for (std::string& field : fields) vectors.push_back({field.data(), field.size()});
+  return sd_journal_sendv(vectors.data(), static_cast<int>(vectors.size())) >= 0;
+}
+
 void log_line(const std::string& text) {
+  if (journal_with_fields(text)) return;
   std::fprintf(stderr, "cdpr-calibd: %s\n", text.c_str());
   std::fflush(stderr);
 }
@@ -170,6 +195,11 @@ int main(int argc, char** argv) {
     log_line("winches: no EDS for " + plain + " ([winches.drive] / [winches.encoder] eds): configured with the CiA "
              "402/406 defaults (4 PDOs, transmission type 255, increments per second unless 0x60A9 says otherwise)");
   }
+  // Watch mode: the robot's controller owns the bus; the daemon only listens (docs/operation-watch-mode.md).
+  drivers::can::ListeningWinchBank listener(winch_config, config->operation.listen,
+                                            drivers::can::make_can_connector(config->winches.endpoint));
+  hal::WinchBank& bank = config->operation.watch ? static_cast<hal::WinchBank&>(listener) : winches;
+  if (config->operation.watch) log_line("watch mode: listening on the CAN bus, sending nothing");
   drivers::modbus::ModbusLoadCell modbus_load_cell(cell_config, clock);
   // The Modbus transaction (up to response timeout x tries) runs on the
   // reader's thread, never in the 20 ms loop.
@@ -186,7 +216,7 @@ int main(int argc, char** argv) {
   std::signal(SIGPIPE, SIG_IGN);
 
   SdNotifier notifier(monotonic_clock);
-  daemon::DaemonLoop loop(*config, *robot, {winches, load_cell, pose, button.get()}, store, clock, notifier, log_line);
+  daemon::DaemonLoop loop(*config, *robot, {bank, load_cell, pose, button.get()}, store, clock, notifier, log_line);
   if (const hal::Status started = loop.start(); !started.ok()) {
     log_line(started.to_string());
     return 1;

@@ -34,6 +34,16 @@ CanFrame frame_of(std::uint32_t id, std::uint8_t len) {
 
 }  // namespace
 
+const char* to_string(NmtState state) {
+  switch (state) {
+    case NmtState::kBootUp: return "boot-up";
+    case NmtState::kStopped: return "stopped";
+    case NmtState::kOperational: return "operational";
+    case NmtState::kPreOperational: return "pre-operational";
+  }
+  return "unknown";
+}
+
 std::optional<int> node_of(const CanFrame& frame, std::uint32_t base) {
   if (frame.id <= base || frame.id > base + kMaxNodeId) return std::nullopt;
   return static_cast<int>(frame.id - base);

@@ -45,6 +45,9 @@ enum class NmtState : std::uint8_t {
   kPreOperational = 0x7F,
 };
 
+// "boot-up", "stopped", "operational", "pre-operational".
+const char* to_string(NmtState state);
+
 // Node id of a frame in the function-code range `base` (e.g. kHeartbeatBase),
 // or nullopt when the frame is of another kind.
 std::optional<int> node_of(const CanFrame& frame, std::uint32_t base);

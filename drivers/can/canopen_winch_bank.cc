@@ -309,12 +309,8 @@ void CanopenWinchBank::on_position(Winch& w, std::uint32_t raw, hal::TimeUs now_
   const std::size_t i = static_cast<std::size_t>(&w - winches_.data());
   const CanWinchConfig& c = config_.winches[i];
   const double m_per_count = std::abs(c.encoder_node_id == 0 ? c.drive_m_per_count : c.encoder_m_per_count);
-  // Readings queued together arrive with one receive time: allow the change
-  // of one heartbeat timeout on top of the time between them.
-  const hal::TimeUs since_us = w.encoder_time_us < 0 ? 0 : now_us - w.encoder_time_us;
-  const double max_change_counts =
-      config_.max_speed_mps * 1e-6 * static_cast<double>(since_us + config_.heartbeat_timeout_us) / m_per_count;
-  switch (w.encoder.add(raw, max_change_counts)) {
+  switch (w.encoder.add(raw, EncoderUnwrap::max_change_counts(config_.max_speed_mps, w.encoder_time_us, now_us,
+                                                              config_.heartbeat_timeout_us, m_per_count))) {
     case EncoderUnwrap::Outcome::kOk:
       w.encoder_time_us = now_us;
       return;

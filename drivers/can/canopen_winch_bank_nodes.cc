@@ -6,20 +6,6 @@
 #include "drivers/can/canopen_winch_bank.h"
 
 namespace cdpr::drivers::can {
-namespace {
-
-const char* nmt_name(NmtState state) {
-  switch (state) {
-    case NmtState::kBootUp: return "boot-up";
-    case NmtState::kStopped: return "stopped";
-    case NmtState::kOperational: return "operational";
-    case NmtState::kPreOperational: return "pre-operational";
-  }
-  return "unknown";
-}
-
-}  // namespace
-
 int CanopenWinchBank::node_count(int winch) const {
   if (winch < 0 || winch >= winch_count()) std::abort();  // caller's broken invariant (hal/winch_bank.h)
   return winches_[static_cast<std::size_t>(winch)].encoder_node.id != 0 ? 2 : 1;
@@ -38,7 +24,7 @@ hal::NodeStatus CanopenWinchBank::node_status(int winch, int index) const {
   s.heartbeat_age_us = age(node.last_heartbeat_us);
   s.pdo_age_us = age(node.last_pdo_us);
   if (node.last_heartbeat_us >= 0) {
-    s.nmt = s.heartbeat_age_us > config_.heartbeat_timeout_us ? "silent" : nmt_name(node.nmt_state);
+    s.nmt = s.heartbeat_age_us > config_.heartbeat_timeout_us ? "silent" : to_string(node.nmt_state);
   }
   if (drive && w.drive.has_status()) {
     s.power_state = cia402::to_string(w.drive.power_state());

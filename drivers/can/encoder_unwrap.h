@@ -29,6 +29,16 @@ class EncoderUnwrap {
   // Forgets the history (node rebooted, range changed, fault acknowledged).
   void reset();
 
+  // The most a payout of at most max_speed_mps may change [counts] between
+  // the previous reading (at previous_us; < 0: none) and one at now_us.
+  // Readings queued together arrive with one receive time: the change of
+  // `allowance_us` is allowed on top of the time between them.
+  static double max_change_counts(double max_speed_mps, std::int64_t previous_us, std::int64_t now_us,
+                                  std::int64_t allowance_us, double m_per_count) {
+    const std::int64_t since_us = previous_us < 0 ? 0 : now_us - previous_us;
+    return max_speed_mps * 1e-6 * static_cast<double>(since_us + allowance_us) / m_per_count;
+  }
+
   enum class Outcome { kOk, kOutOfRange, kJump };
   // One reading; max_change_counts bounds |change| since the previous one.
   Outcome add(std::uint32_t raw, double max_change_counts);

@@ -6,7 +6,8 @@
 namespace cdpr::control {
 
 std::string respond(std::string_view request_line, calibration::CalibrationStateMachine& machine,
-                    store::CalibrationStore& store, hal::TimeUs now_us, RefitService* refits) {
+                    store::CalibrationStore& store, hal::TimeUs now_us, RefitService* refits,
+                    const operation::OperationStatus* operation) {
   const auto request = parse_request(request_line);
   if (!request) return format_error_response(request.error());
   switch (request->kind) {
@@ -19,7 +20,8 @@ std::string respond(std::string_view request_line, calibration::CalibrationState
       }
       return format_ok_response("aborted: " + machine.status().reason);
     case RequestKind::kStatus:
-      return format_status_response(machine.status(), now_us, refits ? refits->refit_status() : std::nullopt);
+      return format_status_response(machine.status(), now_us, refits ? refits->refit_status() : std::nullopt,
+                                    operation);
     case RequestKind::kResetFaults:
       if (!machine.request_reset_faults(now_us)) return format_error_response(machine.status().note);
       return format_ok_response(machine.status().note);

@@ -20,12 +20,15 @@
 #include "hal/clock.h"
 #include "src/calibration/calibration_state_machine.h"
 #include "src/control/refit_service.h"
+#include "src/operation/operation_watch.h"
 #include "src/store/calibration_store.h"
 
 namespace cdpr::control {
 
 // `refits` may be null: refit is then refused as not available.
+// `operation`: watch mode's status for `status` (null: not watching).
 std::string respond(std::string_view request_line, calibration::CalibrationStateMachine& machine,
-                    store::CalibrationStore& store, hal::TimeUs now_us, RefitService* refits = nullptr);
+                    store::CalibrationStore& store, hal::TimeUs now_us, RefitService* refits = nullptr,
+                    const operation::OperationStatus* operation = nullptr);
 
 }  // namespace cdpr::control

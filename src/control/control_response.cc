@@ -138,8 +138,58 @@ Json nodes_json(const std::vector<calibration::CalibrationStatus::Node>& nodes) 
 
 }  // namespace
 
+namespace {
+
+Json operation_json(const operation::OperationStatus* operation, hal::TimeUs now_us) {
+  if (operation == nullptr) return nullptr;
+  const operation::OperationStatus& o = *operation;
+  Json json;
+  json["mode"] = "watch";
+  json["state"] = o.state;
+  json["calibration_seq"] = o.calibration_seq;
+  json["rests"] = o.rests;
+  json["localized"] = o.localized;
+  json["detail"] = o.detail;
+  json["last_problem"] = o.last_problem;
+  if (!o.last) {
+    json["last_rest"] = nullptr;
+  } else {
+    Json last;
+    last["rest"] = o.last->rest;
+    last["age_s"] = 1e-6 * static_cast<double>(now_us - o.last->seen_us);
+    last["position"] = vector3(o.last->position_world);
+    last["position_sigma"] = vector3(o.last->position_sigma_m);
+    last["orientation_sigma"] = vector3(o.last->orientation_sigma_rad);
+    last["onboard_sigmas"] = o.last->onboard_sigmas;
+    json["last_rest"] = std::move(last);
+  }
+  if (!o.finding) {
+    json["finding"] = nullptr;
+  } else {
+    const operation::FindingSummary& f = *o.finding;
+    Json finding;
+    finding["term"] = f.term;
+    finding["meaning"] = f.meaning;
+    finding["cable"] = f.cable;
+    finding["value"] = f.value;
+    finding["sigma"] = f.sigma;
+    finding["since_rest"] = f.since_rest;
+    finding["fired_at_rest"] = f.fired_at_rest;
+    finding["fired_s_ago"] = 1e-6 * static_cast<double>(now_us - f.fired_us);
+    finding["rests_fitted"] = f.rests_fitted;
+    finding["calibration_fault"] = f.calibration_fault;
+    finding["alike"] = string_array(f.alike);
+    json["finding"] = std::move(finding);
+  }
+  json["refit"] = o.refit;
+  return json;
+}
+
+}  // namespace
+
 std::string format_status_response(const calibration::CalibrationStatus& status, hal::TimeUs now_us,
-                                   const std::optional<RefitStatus>& refit) {
+                                   const std::optional<RefitStatus>& refit,
+                                   const operation::OperationStatus* operation) {
   Json json;
   json["ok"] = true;
   json["state"] = calibration::to_string(status.state);
@@ -177,6 +227,7 @@ std::string format_status_response(const calibration::CalibrationStatus& status,
   }
   json["refit"] = refit_json(refit);
   json["nodes"] = nodes_json(status.nodes);
+  json["operation"] = operation_json(operation, now_us);
   return line(json);
 }
 

@@ -30,6 +30,19 @@
 //            past the heartbeat timeout, "unknown" never heard), CiA 402 power state (drives;
 //            "" before a statusword), 0x603F while in fault, the last EMCY since the bus was
 //            opened, ages null when never heard
+//            operation: watch mode ([operation] watch, docs/operation-watch-mode.md), null when
+//            not watching: {"mode":"watch","state":"watching","calibration_seq":4,"rests":12,
+//            "localized":12,"detail":"at rest","last_problem":"",
+//            "last_rest":{"rest":12,"age_s":3.1,"position":[x,y,z],"position_sigma":[..],
+//            "orientation_sigma":[..],"onboard_sigmas":1.2},
+//            "finding":{"term":"offset[2]","meaning":"encoder offset slip of cable 2","cable":2,
+//            "value":[0.021],"sigma":[0.002],"since_rest":7,"fired_at_rest":9,"fired_s_ago":40.5,
+//            "rests_fitted":3,"calibration_fault":true,"alike":[]},
+//            "refit":"kept in pending/ for `calibctl commit` (...)"}: state "no calibration",
+//            "waiting for a rest", "watching" or "calibration stale"; last_rest null before the
+//            first rest localized from the cables; finding null until the health test fires
+//            (solver/operation/health_watch.h: term names and units); refit what became of the
+//            offered re-fit ("" before)
 //   show     {"ok":true,"present":true,"seq":4,"created":"2026-11-22T10:15:00Z","robot":"large",
 //             "model":["catenary"],"samples":35,
 //             "winches":[{"anchor":[x,y,z],"anchor_sigma":[..],"offset":3.2,"offset_sigma":0.03},...],
@@ -58,13 +71,15 @@
 #include "src/calibration/calibration_state.h"
 #include "src/control/protocol_answer.h"
 #include "src/control/refit_service.h"
+#include "src/operation/operation_watch.h"
 #include "src/store/calibration_store.h"
 #include "src/store/run_history.h"
 
 namespace cdpr::control {
 
 std::string format_status_response(const calibration::CalibrationStatus& status, hal::TimeUs now_us,
-                                   const std::optional<RefitStatus>& refit = std::nullopt);
+                                   const std::optional<RefitStatus>& refit = std::nullopt,
+                                   const operation::OperationStatus* operation = nullptr);
 std::string format_show_response(const std::optional<store::CurrentCalibration>& current,
                                  const std::optional<store::RunEntry>& run = std::nullopt);
 std::string format_history_response(const std::vector<store::HistoryEntry>& history);

@@ -6,6 +6,7 @@
 #include "src/daemon/config_checks.h"
 #include "src/daemon/config_table.h"
 #include "src/daemon/device_config_tables.h"
+#include "src/daemon/operation_config_table.h"
 #include "src/formats/text_file.h"
 #include "src/formats/toml_reader.h"
 
@@ -368,6 +369,7 @@ std::vector<Section> make_sections() {
   s.push_back(bind(equilibrium_table(), [](auto& c) -> auto& { return c.calibrator; }));
   s.push_back(bind(solver_table(), [](auto& c) -> auto& { return c.solver; }));
   s.push_back(bind(validation_table(), [](auto& c) -> auto& { return c.calibrator.validation; }));
+  s.push_back(bind(operation_table(), [](auto& c) -> auto& { return c.operation; }));
   // Each table's sub-tables are keys it allows.
   for (Section& parent : s) {
     for (const Section& child : s) {

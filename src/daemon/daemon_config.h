@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "drivers/can/canopen_winch_bank.h"
+#include "drivers/can/listening_winch_bank.h"
 #include "drivers/modbus/modbus_load_cell.h"
 #include "hal/clock.h"
 #include "solver/calibration/calibrate.h"
@@ -57,6 +58,26 @@ struct ButtonConfig {
   int line = 0;
   bool active_low = false;
   hal::TimeUs debounce_us = 0;
+};
+
+// [operation]: the daemon between calibration runs, next to the robot's
+// own controller (docs/operation-watch-mode.md). watch = true: the CAN bus
+// is only listened to (the listener's layout below), every rest the
+// platform makes is checked against the committed calibration, and its
+// pose from the cables is served on pose_output.
+struct OperationConfig {
+  bool watch = false;
+  // Where the pose from the cables goes: "unix:<path>" (the daemon listens,
+  // every client gets a line per rest, docs/FORMATS.md "Pose from the
+  // cables"); empty: not served.
+  std::string pose_output;
+  // The watch's rest detection: the [equilibrium] thresholds with these
+  // windows (a production rest is seconds, a calibration waypoint's minutes).
+  hal::TimeUs rest_window_us = 2'000'000;
+  hal::TimeUs return_window_us = 6'000'000;
+  // Health watch: the designed false-alarm rate, one per this many clean rests.
+  double clean_rests_per_false_alarm = 1000.0;
+  drivers::can::ListenLayout listen;
 };
 
 // [history]: every run's data kept in the store's history (run_recorder.h).
@@ -96,6 +117,7 @@ struct DaemonConfig {
   ButtonConfig button;
   calibration::CalibratorOptions calibrator;  // [limits], [waypoints], [equilibrium], [validation]
   CalibrationOptions solver;                  // [solver]
+  OperationConfig operation;                  // [operation]
 
   // Where the configuration came from and the line of every key it set
   // ("waypoints.z_max" -> 57), so that checks spanning several keys can

@@ -56,6 +56,7 @@ DaemonLoop::DaemonLoop(const DaemonConfig& config, const Robot& robot, DaemonDev
   recorder_ = std::make_unique<RunRecorder>(
       store_.state_dir(), static_cast<std::uintmax_t>(config_.history.budget_mb * kBytesPerMb), model_check,
       config_.solver);
+  if (config_.operation.watch) watch_ = std::make_unique<WatchService>(config_, robot_, store_, log_);
   refitter_ = std::make_unique<RunRefitter>(robot_, store_.history_dir(), store_, config_.solver,
                                             config_.calibrator.validation, utc_now_rfc3339, log_);
 }
@@ -68,6 +69,9 @@ hal::Status DaemonLoop::start() {
       config_.control_socket_group);
   if (!server.ok()) return server.status();
   server_ = std::move(server.value());
+  if (watch_) {
+    if (hal::Status started = watch_->start(); !started.ok()) return started;
+  }
   report_previous_state();
   const hal::TimeUs now_us = clock_.now_us();
   service_idle_devices(now_us);
@@ -164,7 +168,7 @@ void DaemonLoop::log_device_faults() {
 }
 
 std::string DaemonLoop::handle_request(std::string_view line) {
-  return control::respond(line, *machine_, store_, clock_.now_us(), refitter_.get());
+  return control::respond(line, *machine_, store_, clock_.now_us(), refitter_.get(), operation_status());
 }
 
 void DaemonLoop::run(const std::atomic<bool>& stop) {
@@ -192,7 +196,10 @@ void DaemonLoop::run_once() {
 }
 
 void DaemonLoop::step(hal::TimeUs now_us) {
-  if (!machine_->owns_hardware()) service_idle_devices(now_us);
+  if (!machine_->owns_hardware()) {
+    service_idle_devices(now_us);
+    if (watch_) step_watch(now_us);
+  }
   machine_->step(now_us);
   manage_waypoint_job(now_us);
   manage_solve(now_us);
@@ -202,6 +209,17 @@ void DaemonLoop::step(hal::TimeUs now_us) {
   log_device_faults();
   report(now_us);
   notifier_.watchdog();
+}
+
+void DaemonLoop::step_watch(hal::TimeUs now_us) {
+  // A commit (a run's, `calibctl commit`, a refit) or a rollback changes what the rests are checked against.
+  const int seq = machine_->status().committed_seq;
+  if (seq != watched_seq_) {
+    if (watched_seq_ >= 0) watch_->reload_calibration();
+    watched_seq_ = seq;
+  }
+  watch_->step(devices_, now_us);
+  if (watch_->take_pending_offered()) machine_->refresh_store_problems();  // status: pending_commit
 }
 
 void DaemonLoop::service_idle_devices(hal::TimeUs now_us) {
@@ -331,7 +349,7 @@ void DaemonLoop::shutdown() {
   for (const std::string& message : recorder_->take_messages()) {
     if (log_) log_(message);
   }
-  if (winches_open_) {
+  if (winches_open_ && !watch_) {
     // Stop every winch whatever the machine did: the daemon will not watch them any more.
     const hal::Status stopped = devices_.winches.quick_stop();
     if (!stopped.ok() && log_) log_("quick stop failed: " + stopped.to_string());
@@ -344,7 +362,8 @@ void DaemonLoop::shutdown() {
   devices_.pose.close();
   winches_open_ = load_cell_open_ = pose_open_ = false;
   server_.reset();
-  if (log_) log_("stopped: winches quick-stopped, devices closed");
+  if (log_) log_(watch_ ? "stopped: devices closed (watch mode: the drives stay the controller's)"
+                        : "stopped: winches quick-stopped, devices closed");
 }
 
 }  // namespace cdpr::daemon

@@ -55,6 +55,7 @@
 #include "src/daemon/run_marker.h"
 #include "src/daemon/run_recorder.h"
 #include "src/daemon/run_refitter.h"
+#include "src/daemon/watch_service.h"
 #include "src/store/calibration_store.h"
 
 namespace cdpr::daemon {
@@ -103,10 +104,14 @@ class DaemonLoop {
   const calibration::CalibrationStateMachine& machine() const { return *machine_; }
   // Waits until the run's data queued so far is on disk (tests).
   void wait_for_history() { recorder_->wait_idle(); }
+  // Watch mode's status ([operation] watch); null when not watching.
+  const operation::OperationStatus* operation_status() const { return watch_ ? &watch_->status() : nullptr; }
 
  private:
   void step(hal::TimeUs now_us);
   void service_idle_devices(hal::TimeUs now_us);
+  // Watch mode: the watch's step, with the calibration read again when the committed one changed.
+  void step_watch(hal::TimeUs now_us);
   // Idle: logs the load cell's first reading, or each new reason why none came.
   void note_load_cell_answer();
   void manage_solve(hal::TimeUs now_us);
@@ -139,6 +144,8 @@ class DaemonLoop {
   std::unique_ptr<ControlServer> server_;
   std::unique_ptr<RunRecorder> recorder_;
   std::unique_ptr<RunRefitter> refitter_;
+  std::unique_ptr<WatchService> watch_;  // [operation] watch only
+  int watched_seq_ = -1;                 // the committed seq the watch last read
   std::future<CalibrationResult> solve_;
   bool solving_ = false;
   std::future<calibration::WaypointJob> waypoint_job_;  // valid while a job is on the worker

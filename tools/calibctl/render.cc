@@ -104,6 +104,35 @@ std::string render_refit(const JsonValue& refit) {
   return out;
 }
 
+// Watch mode's part of the status (docs/operation-watch-mode.md).
+void append_operation(std::string& out, const JsonValue& o) {
+  if (o.is_null()) return;
+  out += format("watch: %s (calibration %d), %d rests, %d localized from the cables; %s\n", o["state"].string().c_str(),
+                o["calibration_seq"].integer(), o["rests"].integer(), o["localized"].integer(),
+                o["detail"].string().c_str());
+  if (const JsonValue last = o["last_rest"]; !last.is_null()) {
+    const JsonValue& p = last["position"];
+    const JsonValue& sp = last["position_sigma"];
+    out += format("  last rest %d, %.0f s ago: at %.3f, %.3f, %.3f m, sigma %.1f, %.1f, %.1f mm; onboard pose %.1f "
+                  "sigma away\n", last["rest"].integer(), last["age_s"].number(), at(p, 0), at(p, 1), at(p, 2),
+                  1e3 * at(sp, 0), 1e3 * at(sp, 1), 1e3 * at(sp, 2), last["onboard_sigmas"].number());
+  }
+  append_if(out, "last problem", o["last_problem"]);
+  if (const JsonValue f = o["finding"]; !f.is_null()) {
+    const auto value = f["value"].array(), sigma = f["sigma"].array();
+    std::string size;
+    for (std::size_t k = 0; k < value.size(); ++k) {
+      size += format("%s%.4g +- %.2g", k == 0 ? "" : ", ", value[k].number(), k < sigma.size() ? sigma[k].number() : 0.0);
+    }
+    append_wrapped(out, "CALIBRATION STALE",
+                   f["meaning"].string() + " (" + f["term"].string() + ": " + size + "), since rest " +
+                       std::to_string(f["since_rest"].integer()) + ", flagged at rest " +
+                       std::to_string(f["fired_at_rest"].integer()) + " " + format("%.0f", f["fired_s_ago"].number()) +
+                       " s ago" + (f["calibration_fault"].boolean() ? "" : "; not a calibration fault"));
+  }
+  append_if(out, "re-fit", o["refit"]);
+}
+
 std::string render_status(const JsonValue& s) {
   std::string out = format("%s", s["state"].string().c_str());
   if (s["waypoints"].integer() > 0) {
@@ -136,6 +165,7 @@ std::string render_status(const JsonValue& s) {
     if (!refit_committed) append_refit_hint(out, run);
   }
   if (const JsonValue refit = s["refit"]; !refit.is_null()) out += "  " + render_refit(refit);
+  append_operation(out, s["operation"]);
   append_nodes(out, s["nodes"]);
   return out;
 }

@@ -132,7 +132,7 @@ bool CanopenNodes::axes_still() const {
 void CanopenNodes::poll(hal::TimeUs now_us, std::vector<drivers::can::CanFrame>& out) {
   scratch_.clear();
   for (int i = 0; i < kCableCount; ++i) {
-    const double reading_m = physics_.payout_m(i) + layout_.encoder_noise_m * rng_.normal();
+    const double reading_m = physics_.payout_m(i) + encoder_slip_m_[i] + layout_.encoder_noise_m * rng_.normal();
     encoders_[i]->set_position_counts(std::llround(reading_m / layout_.encoder_m_per_count));
     drives_[i]->poll(now_us, scratch_);
     encoders_[i]->poll(now_us, scratch_);

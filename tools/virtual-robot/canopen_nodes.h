@@ -83,6 +83,9 @@ class CanopenNodes {
 
   // Node `id` stops talking (heartbeat and PDOs), as a cut cable would.
   void silence(int node_id, bool silent);
+  // Encoder `winch` reads `slip_m` more than the payout from now on (it
+  // slipped on its drum: operation_faults.h).
+  void add_encoder_slip(int winch, double slip_m) { encoder_slip_m_[winch] += slip_m; }
   // Every drive at rest (no profile running).
   bool winches_still() const;
   // A drive is braking to rest on a stop (Cia402Device::braking()).
@@ -99,6 +102,7 @@ class CanopenNodes {
   std::array<std::unique_ptr<Cia402Device>, kCableCount> drives_;
   std::array<std::unique_ptr<Cia406Device>, kCableCount> encoders_;
   std::vector<BusFrame> scratch_;
+  std::array<double, kCableCount> encoder_slip_m_{};
 };
 
 }  // namespace cdpr::virtual_robot

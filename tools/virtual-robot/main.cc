@@ -88,6 +88,29 @@ int main(int argc, char** argv) {
   std::string drive_eds, encoder_eds;
   app.add_option("--drive-eds", drive_eds, "the EDS file the drives play instead (their object dictionary)");
   app.add_option("--encoder-eds", encoder_eds, "the EDS file the encoders play instead");
+  app.add_flag("--operate", options.operation.enabled,
+               "in operation: the robot's own controller commissions and enables the drives and moves the platform "
+               "by itself, random point-to-point moves (drawn from --seed) with rests between; a daemon may only "
+               "listen ([operation] watch = true, docs/operation-watch-mode.md)");
+  app.add_option("--rest-min", options.operation.rest_min_s, "operation: shortest rest after a move [s, simulated]")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--rest-max", options.operation.rest_max_s, "operation: longest rest after a move [s, simulated]")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--job-speed", options.operation.winch_speed_mps,
+                 "operation: the longest cable's speed in a move [m/s, simulated]")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  std::vector<std::string> injections;
+  app.add_option("--inject", injections,
+                 "a fault at a robot time T [s, simulated, since start] (repeatable): slip@T:cable=i,size=METRES "
+                 "(encoder i reads that much more), anchor@T:cable=i,dx=..,dy=..,dz=.. (pulley exit moved [m]), "
+                 "creep@T:cable=i,rate=M_PER_S (the cable lengthens, same reading), payload@T:mass=KG (added)")
+      ->check([](const std::string& text) {
+        std::string why;
+        return cdpr::virtual_robot::parse_operation_fault(text, why) ? std::string() : why;
+      });
+  app.add_option("--frame-log", options.frame_log_path,
+                 "log every CAN frame a bus client (the daemon) sends, one line each: robot clock [us], id, length, data")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   std::string eds_error;
   cdpr::virtual_robot::CanopenNodes::apply(*cdpr::virtual_robot::parse_canopen_quirks(quirks, eds_error), options.nodes);
@@ -95,6 +118,18 @@ int main(int argc, char** argv) {
   if (!encoder_eds.empty()) options.nodes.encoder_eds = cdpr::virtual_robot::read_device_eds(encoder_eds, eds_error);
   if (!eds_error.empty()) {
     std::fprintf(stderr, "virtual-robot: %s\n", eds_error.c_str());
+    return 1;
+  }
+  for (const std::string& text : injections) {
+    std::string why;
+    options.faults.push_back(*cdpr::virtual_robot::parse_operation_fault(text, why));
+  }
+  if (options.operation.rest_max_s < options.operation.rest_min_s) {
+    std::fprintf(stderr, "virtual-robot: --rest-max must be at least --rest-min\n");
+    return 1;
+  }
+  if (options.operation.enabled && quirks.find("rpm-units") != std::string::npos) {
+    std::fprintf(stderr, "virtual-robot: --operate drives the profiles in increments per second: not with rpm-units\n");
     return 1;
   }
   options.preset = *cdpr::sim::parse_preset(preset);
@@ -131,5 +166,11 @@ int main(int argc, char** argv) {
               "not simulated while starved of CPU; longest gap between the master's heartbeats %.0f ms)\n",
               (*robot)->physics().failed_solves(), (*robot)->physics().slack_solves(), (*robot)->robot_time_lost_s(),
               1e-3 * static_cast<double>(heartbeat_gap_us));
+  if (const cdpr::virtual_robot::ProductionController* controller = (*robot)->controller()) {
+    std::printf("virtual-robot: in operation: %d moves, %d rests, %d targets unreachable\n", controller->moves(),
+                controller->rests(), controller->unreachable());
+  }
+  std::printf("virtual-robot: %llu CAN frames received from the bus's clients\n",
+              static_cast<unsigned long long>((*robot)->frames_from_clients()));
   return 0;
 }

@@ -140,6 +140,12 @@ void RobotPhysics::advance(double dt_s) {
   for (int i = 0; i < kCableCount; ++i) tension_n_[i] += a * (rest_.cables[i].tension_n - tension_n_[i]);
 }
 
+void RobotPhysics::change_robot(const sim::TrueRobot& robot) {
+  robot_ = robot;
+  solved_payout_m_.fill(std::numeric_limits<double>::quiet_NaN());  // differs from any payout: solved again
+  since_solve_s_ = options_.equilibrium_interval_s;
+}
+
 double RobotPhysics::natural_frequency_radps() const {
   if (options_.sway_period_s > 0.0) return 2.0 * std::numbers::pi / options_.sway_period_s;
   Eigen::Matrix3d stiffness = Eigen::Matrix3d::Zero();

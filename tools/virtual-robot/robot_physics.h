@@ -73,6 +73,10 @@ class RobotPhysics {
   // virtual robot's CiA 402 drives), the physics only follows.
   void set_payout(int winch, double payout_m) { payout_m_[winch] = target_m_[winch] = payout_m; }
   void advance(double dt_s);
+  // The true robot changes under the running physics (an anchor moved, a
+  // cable crept, a payload changed: operation_faults.h); the rest state is
+  // solved again at the next advance().
+  void change_robot(const sim::TrueRobot& robot);
 
   double payout_m(int winch) const { return payout_m_[winch]; }
   bool at_target(int winch) const { return payout_m_[winch] == target_m_[winch]; }

@@ -22,6 +22,8 @@ namespace {
 
 // A stream of its own for the live sensor noise (sim/stream_purpose.h uses 1-5).
 constexpr std::uint64_t kStreamLiveNoise = 101;
+// And one for the production controller's jobs (operation).
+constexpr std::uint64_t kStreamJobs = 102;
 
 bool write_file(const std::string& path, const std::string& text) {
   std::ofstream file(path, std::ios::binary | std::ios::trunc);
@@ -72,6 +74,18 @@ Expected<std::unique_ptr<VirtualRobot>, std::string> VirtualRobot::create(const 
   robot->nodes_ = std::make_unique<CanopenNodes>(nodes, *robot->physics_,
                                                  sim::Rng::stream(options.seed, kStreamLiveNoise, 1), now_us);
   robot->start_us_ = robot->last_us_ = robot->next_pose_us_ = now_us;
+  if (options.operation.enabled) {
+    std::array<double, kCableCount> payout_m{};
+    for (int i = 0; i < kCableCount; ++i) payout_m[i] = robot->physics_->payout_m(i);
+    robot->controller_ = std::make_unique<ProductionController>(
+        options.operation, robot->data_.true_robot, options.preset, nodes, options.physics.segments,
+        sim::Rng::stream(options.seed, kStreamJobs), payout_m);
+  }
+  robot->fault_schedule_ = std::make_unique<FaultSchedule>(options.faults);
+  if (!options.frame_log_path.empty()) {
+    robot->frame_log_ = std::fopen(options.frame_log_path.c_str(), "w");
+    if (robot->frame_log_ == nullptr) return Unexpected{"cannot write the frame log " + options.frame_log_path};
+  }
 
   auto can = StreamListener::listen(options.dir + "/can.sock");
   if (!can.ok()) return Unexpected{"CAN socket: " + can.status().to_string()};
@@ -108,6 +122,10 @@ Expected<std::unique_ptr<VirtualRobot>, std::string> VirtualRobot::create(const 
 VirtualRobot::VirtualRobot(const VirtualRobotOptions& options, sim::SimulatedDataset data)
     : options_(options), data_(std::move(data)), noise_(sim::Rng::stream(options.seed, kStreamLiveNoise, 0)) {}
 
+VirtualRobot::~VirtualRobot() {
+  if (frame_log_ != nullptr) std::fclose(frame_log_);
+}
+
 void VirtualRobot::run(const std::atomic<bool>& stop) {
   while (!stop.load()) run_once(2'000);
 }
@@ -135,7 +153,23 @@ void VirtualRobot::run_once(hal::TimeUs max_wait_us) {
   last_us_ = now_us;
   robot_clock_->advance_to(robot_clock_us());
   for (int i = 0; i < kCableCount; ++i) payout_snapshot_m_[i].store(physics_->payout_m(i));
+  operate();
   publish(robot_clock_->now_us());
+}
+
+void VirtualRobot::operate() {
+  std::vector<std::string> began;
+  fault_schedule_->apply(robot_time_s_, *physics_, *nodes_, began);
+  for (const std::string& fault : began) {
+    std::printf("virtual-robot: at %.1f s (robot time): %s\n", robot_time_s_, fault.c_str());
+    std::fflush(stdout);
+  }
+  if (!controller_) return;
+  const std::size_t before = controller_frames_.size();
+  controller_->step(robot_time_s_, *nodes_, controller_frames_);
+  // The controller's frames reach the nodes as they would on the wire.
+  const hal::TimeUs now_us = robot_clock_->now_us();
+  for (std::size_t k = before; k < controller_frames_.size(); ++k) nodes_->on_frame(controller_frames_[k], now_us);
 }
 
 hal::TimeUs VirtualRobot::robot_clock_us() const {
@@ -175,20 +209,34 @@ void VirtualRobot::advance(double dt_s) {
 
 void VirtualRobot::on_can_bytes(int client, std::string_view bytes) {
   std::string& partial = can_partial_[client];
-  if (can_fault_.load() != DeviceFault::kNone) return;  // the master's frames never reach the nodes
   partial.append(bytes);
+  // On a faulted bus the master's frames never reach the nodes; they are counted all the same.
+  const bool delivered = can_fault_.load() == DeviceFault::kNone;
   std::size_t used = 0;
   for (; partial.size() - used >= drivers::can::kWireFrameBytes; used += drivers::can::kWireFrameBytes) {
     drivers::can::CanFrame frame;
     if (drivers::can::decode_wire_frame(reinterpret_cast<const std::uint8_t*>(partial.data() + used), frame)) {
-      nodes_->on_frame(frame, robot_clock_->now_us());
+      log_client_frame(frame);
+      if (delivered) nodes_->on_frame(frame, robot_clock_->now_us());
     }
   }
   partial.erase(0, used);
 }
 
+void VirtualRobot::log_client_frame(const drivers::can::CanFrame& frame) {
+  ++frames_from_clients_;
+  if (frame_log_ == nullptr) return;
+  std::fprintf(frame_log_, "%lld %03X %u", static_cast<long long>(robot_clock_->now_us()), frame.id, frame.len);
+  for (int k = 0; k < frame.len && k < 8; ++k) std::fprintf(frame_log_, " %02X", frame.data[k]);
+  std::fputc('\n', frame_log_);
+  std::fflush(frame_log_);
+}
+
 void VirtualRobot::publish(hal::TimeUs now_us) {
   frames_.clear();
+  // The production controller's frames are on the bus too, before the answers they caused.
+  frames_.insert(frames_.end(), controller_frames_.begin(), controller_frames_.end());
+  controller_frames_.clear();
   nodes_->poll(now_us, frames_);
   std::uint8_t wire[drivers::can::kWireFrameBytes];
   std::string bytes;

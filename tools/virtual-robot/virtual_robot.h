@@ -38,6 +38,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <cstdio>
 #include <map>
 #include <memory>
 #include <string>
@@ -51,6 +52,8 @@
 #include "src/formats/expected.h"
 #include "virtual-robot/canopen_nodes.h"
 #include "virtual-robot/modbus_transport.h"
+#include "virtual-robot/operation_faults.h"
+#include "virtual-robot/production_controller.h"
 #include "virtual-robot/virtual_load_cell.h"
 #include "virtual-robot/robot_physics.h"
 #include "virtual-robot/stop_excursion.h"
@@ -81,6 +84,15 @@ struct VirtualRobotOptions {
   // Print a line to stdout when the platform came to rest after a stop
   // (stop_excursion.h: its largest excursion, where it rests).
   bool report_stops = false;
+  // In operation (production_controller.h): the robot's own controller
+  // owns the drives and moves the platform by itself; `faults` happen at
+  // their times (operation_faults.h).
+  OperationOptions operation;
+  std::vector<OperationFault> faults;
+  // Every frame a bus client (the daemon) sends is logged here, one line
+  // each ("<robot clock us> <id hex> <len> <data hex>"); empty: not logged.
+  // frames_from_clients() counts them either way.
+  std::string frame_log_path;
 };
 
 // The simulated data set behind a virtual robot made with `options` (the
@@ -96,6 +108,7 @@ class VirtualRobot {
   static constexpr int kMaxSolvesPerPass = 4;
 
   static Expected<std::unique_ptr<VirtualRobot>, std::string> create(const VirtualRobotOptions& options);
+  ~VirtualRobot();
 
   // Serves the sockets for at most max_wait_us, then advances the physics to
   // now and publishes what is due.
@@ -125,6 +138,12 @@ class VirtualRobot {
   // Winch i's payout [m] as of the last run_once(), readable from any thread.
   double payout_snapshot_m(int winch) const { return payout_snapshot_m_[winch].load(); }
   CanopenNodes& nodes() { return *nodes_; }
+  // CAN frames received from the bus's clients (the daemon) since the
+  // start, whatever the bus fault (any thread).
+  std::uint64_t frames_from_clients() const { return frames_from_clients_.load(); }
+  // The production controller in operation (null otherwise); read it only
+  // from the thread that runs the robot, or after it stopped.
+  const ProductionController* controller() const { return controller_.get(); }
   VirtualLoadCell& load_cell() { return *cell_; }
   // The pose stream's fault (any thread): kSilent stops sending, kGarbage
   // sends lines that are not poses, kDisconnected closes the socket.
@@ -144,11 +163,15 @@ class VirtualRobot {
   hal::TimeUs robot_clock_us() const;
   void publish(hal::TimeUs now_us);
   void on_can_bytes(int client, std::string_view bytes);
+  // Counts (and logs, with frame_log_path) a frame from a bus client.
+  void log_client_frame(const drivers::can::CanFrame& frame);
   void publish_pose(hal::TimeUs now_us);
   // Closes or reopens the pose socket as pose_fault_ says.
   void follow_pose_fault();
   // Closes or reopens the CAN socket as can_fault_ says.
   void follow_can_fault();
+  // The production controller's and the faults' turn (operation).
+  void operate();
 
   VirtualRobotOptions options_;
   sim::SimulatedDataset data_;
@@ -173,6 +196,11 @@ class VirtualRobot {
   hal::TimeUs next_pose_us_ = 0;
   std::vector<drivers::can::CanFrame> frames_;
   std::vector<pollfd> fds_;
+  std::unique_ptr<ProductionController> controller_;
+  std::unique_ptr<FaultSchedule> fault_schedule_;
+  std::vector<drivers::can::CanFrame> controller_frames_;  // sent this pass, onto the bus with the nodes' frames
+  std::atomic<std::uint64_t> frames_from_clients_{0};
+  std::FILE* frame_log_ = nullptr;
 };
 
 }  // namespace cdpr::virtual_robot

@@ -28,7 +28,7 @@ TEST(ControlDispatch, StatusOfAnIdleDaemon) {
             "\"skipped\":0,\"progress\":0,\"elapsed_s\":null,\"strategy\":\"\",\"stop_reason\":\"\",\"sigma\":null,"
             "\"time_left_s\":null,\"reason\":\"\",\"note\":\"\",\"detail\":\"\","
             "\"device_faults\":\"\",\"committed_seq\":0,\"interrupted\":\"\",\"store_problems\":[],\"pending_commit\":false,"
-            "\"run\":null,\"refit\":null,\"nodes\":[]}\n");
+            "\"run\":null,\"refit\":null,\"nodes\":[],\"operation\":null}\n");
 }
 
 // A refit service that records what it was asked and answers as told.
@@ -59,7 +59,7 @@ TEST(ControlDispatch, RefitIsHandedToTheServiceAndRefusedWhileRunning) {
   EXPECT_EQ(refits.asked, (std::vector<std::string>{"3 load_cell_bias"}));
   EXPECT_TRUE(contains(ask_refits("status"),
                        "\"refit\":{\"run\":\"run-000003\",\"terms\":\"load_cell_bias\",\"state\":\"running\","
-                       "\"message\":\"fitting\",\"committed_seq\":0,\"entry\":\"\"},\"nodes\":[]}"))
+                       "\"message\":\"fitting\",\"committed_seq\":0,\"entry\":\"\"},\"nodes\":[],\"operation\":null}"))
       << ask_refits("status");
   // WHEN the service refuses THEN the answer says why
   refits.refusal = "unknown term 'bias'";

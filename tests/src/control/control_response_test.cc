@@ -58,7 +58,7 @@ TEST(ControlResponse, StatusListsEveryNodeWithItsStates) {
                           "\"pdo_age_ms\":12.5,\"heartbeat_age_ms\":40},{\"winch\":0,\"role\":\"encoder\","
                           "\"node_id\":11,\"nmt\":\"unknown\",\"configured\":false,\"cia402\":\"\","
                           "\"error_code\":\"\",\"last_emcy\":\"\",\"emcy_register\":0,\"pdo_age_ms\":null,"
-                          "\"heartbeat_age_ms\":null}]}\n"),
+                          "\"heartbeat_age_ms\":null}],\"operation\":null}\n"),
             std::string::npos)
       << response;
 }
