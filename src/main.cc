@@ -195,7 +195,7 @@ int main(int argc, char** argv) {
     log_line("winches: no EDS for " + plain + " ([winches.drive] / [winches.encoder] eds): configured with the CiA "
              "402/406 defaults (4 PDOs, transmission type 255, increments per second unless 0x60A9 says otherwise)");
   }
-  // Watch mode: the robot's controller owns the bus; the daemon only listens (docs/operation-watch-mode.md).
+  // Watch mode: the robot's controller owns the bus; the daemon only listens (docs/operation.md).
   drivers::can::ListeningWinchBank listener(winch_config, config->operation.listen,
                                             drivers::can::make_can_connector(config->winches.endpoint));
   hal::WinchBank& bank = config->operation.watch ? static_cast<hal::WinchBank&>(listener) : winches;

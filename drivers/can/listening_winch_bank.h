@@ -1,7 +1,7 @@
 #pragma once
 // hal::WinchBank as a passive listener on a bus someone else masters (the
 // robot's own controller in production: watch mode,
-// docs/operation-watch-mode.md). It sends nothing, ever: no NMT, no SDO, no
+// docs/operation.md). It sends nothing, ever: no NMT, no SDO, no
 // heartbeat, no SYNC, no RPDO; there is no send path in this class. It
 // reads what the nodes publish for their master:
 //

@@ -30,7 +30,7 @@
 //            past the heartbeat timeout, "unknown" never heard), CiA 402 power state (drives;
 //            "" before a statusword), 0x603F while in fault, the last EMCY since the bus was
 //            opened, ages null when never heard
-//            operation: watch mode ([operation] watch, docs/operation-watch-mode.md), null when
+//            operation: watch mode ([operation] watch, docs/operation.md), null when
 //            not watching: {"mode":"watch","state":"watching","calibration_seq":4,"rests":12,
 //            "localized":12,"detail":"at rest","last_problem":"",
 //            "last_rest":{"rest":12,"age_s":3.1,"position":[x,y,z],"position_sigma":[..],

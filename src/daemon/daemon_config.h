@@ -61,7 +61,7 @@ struct ButtonConfig {
 };
 
 // [operation]: the daemon between calibration runs, next to the robot's
-// own controller (docs/operation-watch-mode.md). watch = true: the CAN bus
+// own controller (docs/operation.md). watch = true: the CAN bus
 // is only listened to (the listener's layout below), every rest the
 // platform makes is checked against the committed calibration, and its
 // pose from the cables is served on pose_output.

@@ -8,7 +8,7 @@ Table<OperationConfig> operation_table() {
   t.boolean("watch", &OperationConfig::watch, false,
             "between runs only listen on the CAN bus (the robot's controller owns the drives: the daemon sends no "
             "frame), find the platform's rests, serve their pose from the cables and check them against the "
-            "calibration (docs/operation-watch-mode.md)");
+            "calibration (docs/operation.md)");
   t.string("pose_output", &OperationConfig::pose_output, "",
            "\"unix:<path>\": a pose line with its covariance per rest for the controller (docs/FORMATS.md); "
            "absent: not served")

@@ -1,6 +1,6 @@
 #pragma once
 // Watch mode's OS wiring ([operation] watch = true,
-// docs/operation-watch-mode.md): between calibration runs, every loop step
+// docs/operation.md): between calibration runs, every loop step
 // hands the devices' latest readings (the listen-only winch bank's
 // payouts, the onboard pose, the load cell) to the pure OperationWatch
 // (src/operation/operation_watch.h); at each rest it serves the pose from

@@ -1,5 +1,5 @@
 #pragma once
-// Watch mode's logic (docs/operation-watch-mode.md), apart from the OS
+// Watch mode's logic (docs/operation.md), apart from the OS
 // wiring (src/daemon/watch_service.h): rests found by RestWatch, each
 // checked by the health watch against the committed calibration
 // (solver/operation/health_watch.h: the pose from the cables with its

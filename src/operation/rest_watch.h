@@ -1,6 +1,6 @@
 #pragma once
 // Finds the rests of a platform that the robot's own controller moves
-// (watch mode, docs/operation-watch-mode.md): every new pose with the
+// (watch mode, docs/operation.md): every new pose with the
 // payouts and the tension of the same step goes into the calibration's
 // equilibrium detector (src/calibration/equilibrium_detector.h, its
 // thresholds and window as configured); the first settled verdict after a

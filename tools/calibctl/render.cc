@@ -104,7 +104,7 @@ std::string render_refit(const JsonValue& refit) {
   return out;
 }
 
-// Watch mode's part of the status (docs/operation-watch-mode.md).
+// Watch mode's part of the status (docs/operation.md).
 void append_operation(std::string& out, const JsonValue& o) {
   if (o.is_null()) return;
   out += format("watch: %s (calibration %d), %d rests, %d localized from the cables; %s\n", o["state"].string().c_str(),

@@ -91,7 +91,7 @@ int main(int argc, char** argv) {
   app.add_flag("--operate", options.operation.enabled,
                "in operation: the robot's own controller commissions and enables the drives and moves the platform "
                "by itself, random point-to-point moves (drawn from --seed) with rests between; a daemon may only "
-               "listen ([operation] watch = true, docs/operation-watch-mode.md)");
+               "listen ([operation] watch = true, docs/operation.md)");
   app.add_option("--rest-min", options.operation.rest_min_s, "operation: shortest rest after a move [s, simulated]")
       ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--rest-max", options.operation.rest_max_s, "operation: longest rest after a move [s, simulated]")

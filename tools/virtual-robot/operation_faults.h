@@ -1,6 +1,6 @@
 #pragma once
 // What can go wrong with a robot in production, injected into the virtual
-// robot at a chosen time (--inject, docs/operation-watch-mode.md): the
+// robot at a chosen time (--inject, docs/operation.md): the
 // faults the calibration's health watch is for (issue 36).
 //
 //   slip@T:cable=i,size=d     encoder i slips on its drum by d [m]: from T on

@@ -2,7 +2,7 @@
 // The robot's own production controller, as the virtual robot plays it in
 // operation (--operate): it owns the drives and moves the platform through
 // jobs by itself, random point-to-point moves with rests of a few seconds,
-// while cdpr-calibd may only listen (watch mode, docs/operation-watch-mode.md).
+// while cdpr-calibd may only listen (watch mode, docs/operation.md).
 //
 // A CANopen master of its own on the robot's bus: at start it commissions
 // every node over SDO (expedited, size unspecified) the way the daemon's

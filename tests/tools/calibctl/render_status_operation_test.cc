@@ -1,4 +1,4 @@
-// calibctl status's text of watch mode (docs/operation-watch-mode.md): the
+// calibctl status's text of watch mode (docs/operation.md): the
 // state, the last rest's pose from the cables and a stale calibration's finding.
 #include <gtest/gtest.h>
 
