@@ -9,6 +9,7 @@
 #include "input_files.h"
 #include "report.h"
 #include "sim/discriminating_poses.h"
+#include "solver/calibration/noise_components.h"
 #include "src/formats/calibration_toml.h"
 #include "src/formats/waypoints_csv.h"
 
@@ -24,16 +25,13 @@ bool write_text(const std::filesystem::path& path, const std::string& text) {
 }
 
 // The sigmas diagnose weighed the readings with at its end: robot.toml's,
-// scaled by its noise findings.
+// scaled by its noise findings as its steps scaled them (scale_noise).
 NoiseSigmas final_noise(const Robot& robot, const Diagnosis& d) {
-  NoiseSigmas noise = robot.noise;
-  for (const NoiseFinding& f : d.noise) {
-    if (f.group == NoiseGroup::kEncoder) noise.encoder_m *= f.scale;
-    if (f.group == NoiseGroup::kLoadCell) noise.force_n *= f.scale;
-    if (f.group == NoiseGroup::kPosition) noise.position_m *= f.scale;
-    if (f.group == NoiseGroup::kOrientation) noise.orientation_rad *= f.scale;
-  }
-  return noise;
+  Robot scaled = robot;
+  std::vector<Sample> no_rows;
+  CalibrationOptions unused;
+  for (const NoiseFinding& f : d.noise) scale_noise(f.group, f.scale, scaled, no_rows, unused);
+  return scaled.noise;
 }
 
 // For each standing mimic set, the waypoints that tell its members apart
