@@ -147,10 +147,15 @@ int run_solve(const SolveArgs& args) {
         result.misfit_cause == MisfitCause::kModel
             ? "run `cdpr-calib diagnose " + args.robot_path + " " + args.samples_path + "` to find the missing model term"
             : misfit_advice(result.misfit_cause);
+    // -q keeps the warning's verdict (up to its first "; "): the terms and
+    // noise scales behind it are in the summary and the report.
+    const std::string& warning = result.calibration.model_warning;
+    const std::string verdict = args.quiet ? warning.substr(0, warning.find("; ")) : warning;
     std::fprintf(stderr,
-                 "cdpr-calib: %s\ncdpr-calib: the calibration was written but is not to be trusted as it is: %s; "
+                 "cdpr-calib: %s%s\ncdpr-calib: the calibration was written but is not to be trusted as it is: %s; "
                  "or pass --accept-misfit\n",
-                 result.calibration.model_warning.c_str(), advice.c_str());
+                 verdict.c_str(), args.quiet && verdict.size() < warning.size() ? " (the rest: run without -q)" : "",
+                 advice.c_str());
     return 3;
   }
   return 0;
