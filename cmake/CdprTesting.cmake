@@ -2,7 +2,9 @@
 # its kind:
 #   unit         one piece on its own, no process of ours besides the test;
 #                `make check` runs these, all of them within seconds.
-#   integration  the programs, the daemon and the virtual robot together.
+#   integration  the programs, the daemon and the virtual robot together;
+#                also unit binaries' replays of whole simulated
+#                calibrations (CDPR_REPLAY_TESTS, tests/CMakeLists.txt).
 #   slow         anything that takes long, whatever its kind: whole
 #                calibrations, packaging. `make test` runs every kind.
 # The limits leave room for a machine shared with other builds.

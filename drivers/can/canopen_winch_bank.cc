@@ -7,6 +7,7 @@
 #include <limits>
 #include <utility>
 
+#include "drivers/can/drain_frames.h"
 #include "drivers/can/fd_can_transport.h"
 
 namespace cdpr::drivers::can {
@@ -210,17 +211,10 @@ hal::Status CanopenWinchBank::send(const CanFrame& frame) {
 hal::Status CanopenWinchBank::update(hal::TimeUs now_us) {
   if (hal::Status s = check_open(); !s.ok()) return s;
   now_us_ = now_us;
-  CanFrame frame;
-  for (int i = 0; i < config_.max_frames_per_update; ++i) {
-    hal::Result<bool> got = transport_->receive(frame, 0);
-    if (!got.ok()) {
-      ++counters_.errors;
-      if (got.status().code() == hal::ErrorCode::kCorruptData) continue;  // one bad record: skip it
-      return got.status();
-    }
-    if (!got.value()) break;
-    ++counters_.frames_rx;
-    dispatch(frame, now_us);
+  if (hal::Status s = drain_frames(*transport_, config_.max_frames_per_update, counters_,
+                                   [&](const CanFrame& frame) { dispatch(frame, now_us); });
+      !s.ok()) {
+    return s;
   }
   hal::Status first_error = send_master_heartbeat(now_us);
   for (Winch& w : winches_) {

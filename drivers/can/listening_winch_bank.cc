@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "drivers/can/cia402.h"
+#include "drivers/can/drain_frames.h"
 
 namespace cdpr::drivers::can {
 namespace {
@@ -67,19 +68,8 @@ hal::Status ListeningWinchBank::open() {
 hal::Status ListeningWinchBank::update(hal::TimeUs now_us) {
   if (!transport_) return hal::Status(hal::ErrorCode::kNotConnected, "CAN listener: not open");
   now_us_ = now_us;
-  CanFrame frame;
-  for (int i = 0; i < config_.max_frames_per_update; ++i) {
-    hal::Result<bool> got = transport_->receive(frame, 0);
-    if (!got.ok()) {
-      ++counters_.errors;
-      if (got.status().code() == hal::ErrorCode::kCorruptData) continue;
-      return got.status();
-    }
-    if (!got.value()) break;
-    ++counters_.frames_rx;
-    dispatch(frame, now_us);
-  }
-  return hal::Status::Ok();
+  return drain_frames(*transport_, config_.max_frames_per_update, counters_,
+                      [&](const CanFrame& frame) { dispatch(frame, now_us); });
 }
 
 void ListeningWinchBank::dispatch(const CanFrame& frame, hal::TimeUs now_us) {
