@@ -173,7 +173,7 @@ for preset in large small; do
   echo "$preset slip re-fit (where offset[cable] was named: $refit_named/$seeds): the re-fitted offset's change within 5 mm of the slip $refit_within/$refit_named, worst ${refit_err_max} m off"
   echo "$preset slip: a 2 cm slip's standardised shift per rest (RMS over rests):$slip_delta"
   echo "$preset anchor 5 cm: flagged $anchor_flagged/$seeds, named anchor $anchor_named/$seeds, alike only $anchor_alike/$seeds"
-  echo "$preset anchor 5 cm: 2 ln LR anchor over offset (named above 8):$anchor_lr"
+  echo "$preset anchor 5 cm: 2 ln LR anchor over offset (named above the margin, 11.34 by default):$anchor_lr"
   echo "$preset anchor 5 cm: the fitted move beyond an offset, in sigmas:$anchor_sigmas; those sigmas [m]:$anchor_resolution"
   echo "$preset payload +10 %: named load $payload_named/$seeds"
   echo "$preset false alarms: $false_alarms (clean rests $clean_total, plus 10 before each fault)"

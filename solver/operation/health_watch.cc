@@ -126,6 +126,18 @@ std::optional<Eigen::Matrix3d> anchor_beyond_offset(const Eigen::Matrix<double, 
   return Eigen::Matrix3d(both.H.bottomRightCorner(3, 3) - coupling.transpose() * others.solve(coupling));
 }
 
+// x with P(chi-square, 3 degrees of freedom > x) = rate, by bisection of
+// the closed form erfc(sqrt(x / 2)) + sqrt(2 x / pi) e^(-x / 2).
+double chi_square_3_quantile_above(double rate) {
+  const auto tail = [](double x) { return std::erfc(std::sqrt(x / 2.0)) + std::sqrt(2.0 * x / M_PI) * std::exp(-x / 2.0); };
+  double low = 0.0, high = 200.0;
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (low + high);
+    (tail(mid) > rate ? low : high) = mid;
+  }
+  return 0.5 * (low + high);
+}
+
 }  // namespace
 
 std::string fault_term_name(FaultTerm term, int cable) {
@@ -197,6 +209,7 @@ HealthWatch::HealthWatch(Robot robot, Calibration calibration, HealthWatchOption
     }
   }
   tracked_information_ = baseline_information_;
+  anchor_margin_ = chi_square_3_quantile_above(std::clamp(options_.anchor_misnaming_rate, 1e-12, 1.0));
   // Siegmund: a one-sided CUSUM of Gaussian log likelihood ratios with
   // standardised shift delta crosses h, without change, after about
   // e^(h + 1.166 delta) / (delta^2 / 2) rests; Bonferroni over all of them.
@@ -369,8 +382,11 @@ void HealthWatch::attribute() {
   // margin; otherwise the slip, the simpler and commoner fault.
   if (f.term.term == FaultTerm::kCableElongation || f.term.term == FaultTerm::kAnchor) {
     for (const TermEstimate& e : f.candidates) {
-      if (e.term == FaultTerm::kEncoderOffset && e.cable == f.term.cable &&
-          f.term.aic_gain() - e.aic_gain() <= kAlikeAicMargin) {
+      const bool anchor_loses = f.term.term == FaultTerm::kAnchor &&
+                                f.term.chi_square_drop - e.chi_square_drop <= anchor_margin_;
+      const bool elongation_loses = f.term.term == FaultTerm::kCableElongation &&
+                                    f.term.aic_gain() - e.aic_gain() <= kAlikeAicMargin;
+      if (e.term == FaultTerm::kEncoderOffset && e.cable == f.term.cable && (anchor_loses || elongation_loses)) {
         f.term = e;
         break;
       }
@@ -399,9 +415,7 @@ std::optional<AnchorOrOffset> HealthWatch::anchor_or_offset(const RestInformatio
   AnchorOrOffset out;
   out.cable = f.term.cable;
   out.log_likelihood_ratio = anchor->chi_square_drop - offset->chi_square_drop;
-  // The naming rule's margin in 2 ln LR: Akaike's penalty for the two more
-  // columns plus the alike margin.
-  out.margin = 2.0 * 2.0 + kAlikeAicMargin;
+  out.margin = anchor_margin_;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(*beyond);
   const double best = eigen.eigenvalues().maxCoeff();
   out.best_sigma_m = best > 0.0 ? 1.0 / std::sqrt(best) : std::numeric_limits<double>::infinity();

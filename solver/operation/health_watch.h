@@ -53,10 +53,12 @@
 // cable or a move of its anchor is named over that cable's offset slip only
 // when it beats it by that margin: they differ only by how the payout and
 // the cable's direction vary over the rests. For an anchor against an
-// offset that rule is a likelihood-ratio test: the anchor is named when
-// 2 ln LR = (its chi-square drop - the offset's) > 8; under a slip 2 ln LR
-// is at most the chi-square (3 degrees of freedom) of adding the anchor to
-// the offset, so at most 4.6 % of slips are named anchor moves. The finding
+// offset the margin is that of a likelihood-ratio test: the anchor is named
+// when 2 ln LR = (its chi-square drop - the offset's) exceeds the
+// chi-square (3 degrees of freedom) quantile of anchor_misnaming_rate
+// (default 1 %: 11.34): under a slip 2 ln LR is at most the chi-square of
+// adding the anchor to the offset, so at most that rate of slips are named
+// anchor moves. The finding
 // says how well the rests span the cable's directions (AnchorOrOffset): a
 // move the rests cannot resolve beyond an offset change is "looks alike",
 // never an anchor. The finding is re-estimated with every further rest.
@@ -124,6 +126,10 @@ struct HealthWatchOptions {
   // kTracked: the error is re-estimated over this many checked rests, then
   // held; 0: over every rest, which keeps the innovations white.
   int calibration_error_rests = 0;
+  // An anchor is named over its cable's offset when 2 ln LR exceeds the
+  // chi-square (3 degrees of freedom) quantile of this rate: at most this
+  // fraction of offset slips are named anchor moves (AnchorOrOffset).
+  double anchor_misnaming_rate = 0.01;
 };
 
 // One scalar statistic of the sequential test.
@@ -174,10 +180,10 @@ struct TermEstimate {
 struct AnchorOrOffset {
   int cable = -1;
   // 2 ln LR of anchor[i] over offset[i]: the difference of their chi-square
-  // drops. Under an offset slip it is about chi-square with 2 degrees of
-  // freedom (the anchor's three columns nearly contain the offset's).
+  // drops. Under an offset slip it is at most the chi-square (3 degrees of
+  // freedom) of adding the anchor's move to the offset change.
   double log_likelihood_ratio = 0.0;
-  double margin = 0.0;  // the anchor is named when 2 ln LR exceeds this
+  double margin = 0.0;  // the anchor is named when 2 ln LR exceeds this (HealthWatchOptions::anchor_misnaming_rate)
   // How well the rests span the cable's directions: the sigma of an anchor
   // move in the direction these rests resolve best once an offset change
   // may explain it too (infinite when none) [m]. A move smaller than about
@@ -257,6 +263,7 @@ class HealthWatch {
   Eigen::Matrix<double, 16, 16> tracked_information_;
   Eigen::Matrix<double, 16, 1> tracked_score_ = Eigen::Matrix<double, 16, 1>::Zero();
   int tracked_rests_ = 0;
+  double anchor_margin_ = 0.0;  // 2 ln LR above which an anchor is named over the offset
   std::array<int, kFaultColumns> onset_up_{}, onset_down_{};  // where each side last left zero
   double threshold_ = 0.0;
   double reference_payout_m_ = 0.0;

@@ -95,6 +95,9 @@ void add_watch_command(CLI::App& app, WatchArgs& args) {
   cmd->add_option("--calibration-error-rests", args.calibration_error_rests,
                   "tracked: estimate it over this many checked rests, then hold it (0: every rest)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
+  cmd->add_option("--anchor-misnaming-rate", args.anchor_misnaming_rate,
+                  "name an anchor move over its cable's offset slip only when at most this fraction of slips would be")
+      ->check(CLI::Range(1e-9, 0.5))->capture_default_str();
   cmd->add_flag("--no-measured-pose", args.no_measured_pose, "ignore the rows' onboard poses (cables and load cell only)");
   cmd->add_flag("-v,--verbose", args.verbose, "a line per rest: residuals and the largest statistic");
 }
@@ -109,6 +112,7 @@ int run_watch(const WatchArgs& args) {
                               : args.calibration_error == "predictive" ? CalibrationErrorHandling::kPredictive
                                                                        : CalibrationErrorHandling::kTracked;
   options.calibration_error_rests = args.calibration_error_rests;
+  options.anchor_misnaming_rate = args.anchor_misnaming_rate;
   if (!args.calibration_samples_path.empty() &&
       !read_calibration_covariance(args.calibration_samples_path, *in, options.height_sigma_m, options.calibration_covariance)) {
     return 1;
@@ -173,7 +177,7 @@ int run_watch(const WatchArgs& args) {
   }
   if (!f.calibration_fault()) std::printf("  not a calibration fault: update robot.toml's mass and centre of mass\n");
   if (const std::optional<AnchorOrOffset>& a = f.anchor_or_offset) {
-    std::printf("  anchor[%d] or offset[%d]: 2 ln LR %.1f (anchor named above %.0f): %s; the rests resolve a move "
+    std::printf("  anchor[%d] or offset[%d]: 2 ln LR %.1f (anchor named above %.1f): %s; the rests resolve a move "
                 "beyond an offset change to %.4f m (1 sigma) at best, the fitted move is %.1f of those sigmas%s\n",
                 a->cable, a->cable, a->log_likelihood_ratio, a->margin,
                 a->anchor_named() ? "the anchor" : "cannot tell, the offset is the simpler", a->best_sigma_m,

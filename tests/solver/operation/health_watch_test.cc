@@ -155,12 +155,25 @@ TEST(HealthWatch, ASlipIsNotNamedAnAnchorMoveTheRestsCannotResolve) {
   ASSERT_TRUE(named.anchor_or_offset.has_value());
   const AnchorOrOffset* a = &*named.anchor_or_offset;
   EXPECT_EQ(a->cable, 2);
-  EXPECT_DOUBLE_EQ(a->margin, 8.0);
+  EXPECT_NEAR(a->margin, 11.34, 0.01);  // chi-square, 3 degrees of freedom, 1 % above
   EXPECT_FALSE(a->anchor_named()) << "2 ln LR " << a->log_likelihood_ratio;
   EXPECT_EQ(named.term, "offset[2]");
   // AND says how far the rests resolve a move beyond an offset change
   EXPECT_GT(a->best_sigma_m, 0.0);
   EXPECT_TRUE(std::isfinite(a->best_sigma_m));
+}
+
+TEST(HealthWatch, TheAnchorsMarginIsTheChiSquareQuantileOfItsMisnamingRate) {
+  // GIVEN a slip's finding (2 ln LR of anchor over offset: at most chi-square, 3 dof)
+  const test::WatchedRests r = test::watched_rests(sim::Preset::kLarge, 30, 12, slip_from_rest_10(2));
+  for (const auto& [rate, quantile] : {std::pair{0.01, 11.345}, std::pair{0.05, 7.815}, std::pair{0.001, 16.266}}) {
+    HealthWatchOptions options;
+    options.anchor_misnaming_rate = rate;
+    HealthWatch watch(r.sequence.nominal, r.calibration, options);
+    watch_all(watch, r.sequence.rests);
+    ASSERT_TRUE(watch.stale() && watch.finding()->anchor_or_offset);
+    EXPECT_NEAR(watch.finding()->anchor_or_offset->margin, quantile, 2e-3) << "rate " << rate;
+  }
 }
 
 TEST(HealthWatch, AnAnchorMoveTheRestsResolveIsNamed) {
