@@ -37,8 +37,8 @@
 // exactly whatever the calibration's error, but a change of an offset or
 // anchor is slowly learnt as calibration error; held after K rests it is
 // not, and the rate holds up to the error left after K rests. kPredictive
-// only widens V_j by P0. Measured (docs/operation.md): neither flags a slip
-// sooner on the simulated robots, whose flags are limited by delta.
+// only widens V_j by P0. Measured (docs/operation.md): none of the three
+// flags a slip sooner than kIgnored; the flags are limited by delta.
 //
 // When a statistic crosses h the calibration is stale. The rests since the
 // crossing statistic last left zero (the change's onset) are refitted with
@@ -58,10 +58,10 @@
 // chi-square (3 degrees of freedom) quantile of anchor_misnaming_rate
 // (default 1 %: 11.34): under a slip 2 ln LR is at most the chi-square of
 // adding the anchor to the offset, so at most that rate of slips are named
-// anchor moves. The finding
-// says how well the rests span the cable's directions (AnchorOrOffset): a
-// move the rests cannot resolve beyond an offset change is "looks alike",
-// never an anchor. The finding is re-estimated with every further rest.
+// anchor moves. The finding says how well the rests span the cable's
+// directions (AnchorOrOffset): a move the rests cannot resolve beyond an
+// offset change is "looks alike", never an anchor. The finding is
+// re-estimated with every further rest.
 //
 // Term catalogue (the names of diagnose and of the calibration's keys):
 //   offset[i]         encoder offset slip of cable i                 [m]
