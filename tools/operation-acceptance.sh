@@ -25,6 +25,9 @@
 #   payload      +10 % platform mass, centre of mass 2 cm aside, from rest 10,
 #                30 rests: flagged and named load
 # An alarm before rest 10 in a fault run counts as a false alarm too.
+# WATCH_OPTIONS adds options to every cdpr-calib watch (e.g.
+# "--calibration-error tracked --calibration-error-rests 10"); WORK_DIR and
+# SKIP_LOCALIZE (any value) reuse a previous run's robots and skip localize.
 # Both commands get the calibration's joint covariance from its samples
 # (--calibration-samples); LOCALIZE_OPTIONS replaces that for localize
 # (e.g. "--exact-calibration", or " " for the per-axis sigmas).
@@ -34,8 +37,22 @@ seeds=${2:-10}
 clean_rests=${3:-50}
 sim=$build/tools/cdpr-sim/cdpr-sim
 calib=$build/tools/cdpr-calib/cdpr-calib
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+# WORK_DIR keeps the simulated robots and calibrations between runs (to
+# compare WATCH_OPTIONS on the same data); else a temporary directory.
+if [[ -n ${WORK_DIR:-} ]]; then
+  work=$WORK_DIR
+  mkdir -p "$work"
+else
+  work=$(mktemp -d)
+  trap 'rm -rf "$work"' EXIT
+fi
+
+# simulate OUT_DIR OPTIONS...: cdpr-sim into OUT_DIR, unless WORK_DIR already holds it.
+simulate() {
+  local out=$1
+  shift
+  [[ -f $out/samples.csv ]] || "$sim" "$@" --out "$out" >/dev/null
+}
 
 field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<"$2" | head -1; }
 
@@ -49,7 +66,7 @@ robot_options() {
 # watch DIR: the summary line of cdpr-calib watch on DIR's rests.
 watch() {
   "$calib" watch "$1/robot.toml" "$dir/cal/calibration.toml" "$1/samples.csv" --truth "$1/truth_after.toml" \
-    --calibration-samples "$dir/cal/samples.csv" |
+    --calibration-samples "$dir/cal/samples.csv" ${WATCH_OPTIONS:-} |
     grep '^summary:' || true
 }
 
@@ -57,24 +74,28 @@ for preset in large small; do
   mass=$([[ $preset == large ]] && echo 3.4 || echo 0.44)
   loc_rows=0 pos_sq=0 rot_sq=0 z_sq=0 pos_max=0 rot_max=0
   clean_total=0 false_alarms=0
+  anchor_lr="" anchor_sigmas="" anchor_resolution="" slip_delta=""
   slip_ok=0 slip_delay="" refit_err_max=0 refit_named=0 refit_within=0 anchor_named=0 anchor_alike=0 anchor_flagged=0 payload_named=0
   for seed in $(seq 1 "$seeds"); do
     dir=$work/$preset-$seed
     opts=$(robot_options "$preset")
     # shellcheck disable=SC2086
-    "$sim" $opts --seed "$seed" --out "$dir/cal" >/dev/null
-    "$calib" solve -q "$dir/cal/robot.toml" "$dir/cal/samples.csv" -o "$dir/cal/calibration.toml" >/dev/null 2>&1 || true
+    if [[ ! -f $dir/cal/calibration.toml ]]; then
+      "$sim" $opts --seed "$seed" --out "$dir/cal" >/dev/null
+      "$calib" solve -q "$dir/cal/robot.toml" "$dir/cal/samples.csv" -o "$dir/cal/calibration.toml" >/dev/null 2>&1 || true
+    fi
     [[ -f $dir/cal/calibration.toml ]] || { echo "$preset seed $seed: no calibration"; continue; }
     cable=$((seed % 4))
 
     # shellcheck disable=SC2086
-    "$sim" $opts --seed "$seed" --rests "$clean_rests" --out "$dir/clean" >/dev/null
+    simulate "$dir/clean" $opts --seed "$seed" --rests "$clean_rests"
+    line=""
     # shellcheck disable=SC2086
-    line=$("$calib" localize "$dir/clean/robot.toml" "$dir/cal/calibration.toml" "$dir/clean/samples.csv" \
+    [[ -n ${SKIP_LOCALIZE:-} ]] || line=$("$calib" localize "$dir/clean/robot.toml" "$dir/cal/calibration.toml" "$dir/clean/samples.csv" \
       --true-poses "$dir/clean/true_poses.csv" -o "$dir/clean/poses.csv" \
       ${LOCALIZE_OPTIONS:---calibration-samples $dir/cal/samples.csv} 2>&1 |
       grep '^against' || true)
-    rows=$(field rows "$line")
+    rows=$(field rows "${line:-}")
     if [[ -n $rows ]]; then
       read -r loc_rows pos_sq rot_sq z_sq pos_max rot_max < <(awk -v n="$loc_rows" -v ps="$pos_sq" -v rs="$rot_sq" \
         -v zs="$z_sq" -v pm="$pos_max" -v rm="$rot_max" -v r="$rows" -v p="$(field position_rms_m "$line")" \
@@ -88,8 +109,7 @@ for preset in large small; do
       echo "$preset seed $seed: false alarm on clean rests: $summary"
 
     # shellcheck disable=SC2086
-    "$sim" $opts --seed "$seed" --rests 30 --fault slip --fault-cable $cable --fault-size 0.02 --fault-from 10 \
-      --out "$dir/slip" >/dev/null
+    simulate "$dir/slip" $opts --seed "$seed" --rests 30 --fault slip --fault-cable $cable --fault-size 0.02 --fault-from 10
     summary=$(watch "$dir/slip")
     fired=$(field fired_rest "$summary")
     term=$(field term "$summary")
@@ -102,6 +122,7 @@ for preset in large small; do
       echo "$preset seed $seed slip on cable $cable: $summary"
     fi
     [[ -n $fired ]] && slip_delay="$slip_delay $((fired - 10 + 1))"
+    slip_delta="$slip_delta $(field offset_delta "$summary")"
     delta=$(field refit_delta_m "$summary")
     if [[ -n $delta && $term == "offset[$cable]" ]]; then
       refit_named=$((refit_named + 1))
@@ -111,10 +132,14 @@ for preset in large small; do
     fi
 
     # shellcheck disable=SC2086
-    "$sim" $opts --seed "$seed" --rests 70 --fault anchor --fault-cable $cable --fault-size 0.05 --fault-from 10 \
-      --out "$dir/anchor" >/dev/null
+    simulate "$dir/anchor" $opts --seed "$seed" --rests 70 --fault anchor --fault-cable $cable --fault-size 0.05 --fault-from 10
     summary=$(watch "$dir/anchor")
     fired=$(field fired_rest "$summary")
+    if [[ -n $(field anchor_2lnlr "$summary") ]]; then
+      anchor_lr="$anchor_lr $(field anchor_2lnlr "$summary")"
+      anchor_sigmas="$anchor_sigmas $(field anchor_move_sigmas "$summary")"
+      anchor_resolution="$anchor_resolution $(field anchor_best_sigma_m "$summary")"
+    fi
     if [[ -n $fired && $fired -ge 10 ]]; then
       anchor_flagged=$((anchor_flagged + 1))
       if [[ $(field term "$summary") == "anchor[$cable]" ]]; then
@@ -131,8 +156,8 @@ for preset in large small; do
     fi
 
     # shellcheck disable=SC2086
-    "$sim" $opts --seed "$seed" --rests 30 --fault payload --fault-size "$mass" --fault-com 0.02,0,0 \
-      --fault-from 10 --out "$dir/payload" >/dev/null
+    simulate "$dir/payload" $opts --seed "$seed" --rests 30 --fault payload --fault-size "$mass" --fault-com 0.02,0,0 \
+      --fault-from 10
     summary=$(watch "$dir/payload")
     fired=$(field fired_rest "$summary")
     if [[ -n $fired && $fired -ge 10 && $(field term "$summary") == load ]]; then
@@ -146,7 +171,10 @@ for preset in large small; do
     'BEGIN { if (n > 0) printf "%s localization: %d rests, position error RMS %.4f m (max %.4f), orientation RMS %.5f rad (max %.5f), error/sigma RMS %.2f\n", p, n, sqrt(ps / n), pm, sqrt(rs / n), rm, sqrt(zs / n) }'
   echo "$preset slip 2 cm: flagged within 10 rests with the right cable $slip_ok/$seeds; rests to flag:$slip_delay"
   echo "$preset slip re-fit (where offset[cable] was named: $refit_named/$seeds): the re-fitted offset's change within 5 mm of the slip $refit_within/$refit_named, worst ${refit_err_max} m off"
+  echo "$preset slip: a 2 cm slip's standardised shift per rest (RMS over rests):$slip_delta"
   echo "$preset anchor 5 cm: flagged $anchor_flagged/$seeds, named anchor $anchor_named/$seeds, alike only $anchor_alike/$seeds"
+  echo "$preset anchor 5 cm: 2 ln LR anchor over offset (named above the margin, 11.34 by default):$anchor_lr"
+  echo "$preset anchor 5 cm: the fitted move beyond an offset, in sigmas:$anchor_sigmas; those sigmas [m]:$anchor_resolution"
   echo "$preset payload +10 %: named load $payload_named/$seeds"
   echo "$preset false alarms: $false_alarms (clean rests $clean_total, plus 10 before each fault)"
 done

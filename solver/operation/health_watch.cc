@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Dense>
 
@@ -62,29 +63,37 @@ struct Fit {
 };
 
 Fit joint_fit(const Eigen::Matrix<double, kBaseline, kBaseline>& prior, const RestInformation& before,
-              const RestInformation& since, int first, int columns) {
+              const RestInformation& since, const std::vector<int>& changed) {
   Fit f;
+  const int columns = static_cast<int>(changed.size());
   const int n = kBaseline + columns;
   f.H = Eigen::MatrixXd::Zero(n, n);
   f.g = Eigen::VectorXd::Zero(n);
   f.H.topLeftCorner(kBaseline, kBaseline) = prior + before.information.topLeftCorner<kBaseline, kBaseline>() +
                                             since.information.topLeftCorner<kBaseline, kBaseline>();
   f.g.head(kBaseline) = before.score.head<kBaseline>() + since.score.head<kBaseline>();
-  if (columns > 0) {
-    f.H.block(0, kBaseline, kBaseline, columns) = since.information.block(0, first, kBaseline, columns);
-    f.H.block(kBaseline, 0, columns, kBaseline) = since.information.block(first, 0, columns, kBaseline);
-    f.H.bottomRightCorner(columns, columns) = since.information.block(first, first, columns, columns);
-    f.g.tail(columns) = since.score.segment(first, columns);
+  for (int a = 0; a < columns; ++a) {
+    const int j = changed[a];
+    f.H.block(0, kBaseline + a, kBaseline, 1) = since.information.block(0, j, kBaseline, 1);
+    f.H.block(kBaseline + a, 0, 1, kBaseline) = since.information.block(j, 0, 1, kBaseline);
+    for (int b = 0; b < columns; ++b) f.H(kBaseline + a, kBaseline + b) = since.information(j, changed[b]);
+    f.g(kBaseline + a) = since.score(j);
   }
   return f;
+}
+
+std::vector<int> columns_of(const Candidate& c) {
+  std::vector<int> out;
+  for (int k = 0; k < c.columns; ++k) out.push_back(c.first_column + k);
+  return out;
 }
 
 // The fit of one candidate: theta and its covariance from H^-1 g, its
 // chi-square drop over the fit without it.
 std::optional<TermEstimate> fit_candidate(const Candidate& c, const Eigen::Matrix<double, kBaseline, kBaseline>& prior,
                                           const RestInformation& before, const RestInformation& since) {
-  const Fit with = joint_fit(prior, before, since, c.first_column, c.columns);
-  const Fit without = joint_fit(prior, before, since, c.first_column, 0);
+  const Fit with = joint_fit(prior, before, since, columns_of(c));
+  const Fit without = joint_fit(prior, before, since, {});
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(with.H), ldlt0(without.H);
   if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || !(ldlt.vectorD().minCoeff() > 1e-12 * with.H.trace()) ||
       ldlt0.info() != Eigen::Success) {
@@ -99,6 +108,34 @@ std::optional<TermEstimate> fit_candidate(const Candidate& c, const Eigen::Matri
   e.sigma = covariance.bottomRightCorner(c.columns, c.columns).diagonal().cwiseSqrt();
   e.chi_square_drop = with.g.dot(x) - without.g.dot(ldlt0.solve(without.g));
   return e;
+}
+
+// What the rests since the onset tell of an anchor move beyond an offset
+// change of the same cable: F, the information of the anchor's columns with
+// the calibration's error and the offset change eliminated (a Schur
+// complement of the joint fit over both).
+std::optional<Eigen::Matrix3d> anchor_beyond_offset(const Eigen::Matrix<double, kBaseline, kBaseline>& prior,
+                                                    const RestInformation& before, const RestInformation& since,
+                                                    int cable) {
+  const int anchor = 4 + 3 * cable;
+  const Fit both = joint_fit(prior, before, since, {cable, anchor, anchor + 1, anchor + 2});
+  const int rest = kBaseline + 1;
+  const Eigen::LDLT<Eigen::MatrixXd> others(both.H.topLeftCorner(rest, rest));
+  if (others.info() != Eigen::Success || !others.isPositive()) return std::nullopt;
+  const Eigen::MatrixXd coupling = both.H.block(0, rest, rest, 3);
+  return Eigen::Matrix3d(both.H.bottomRightCorner(3, 3) - coupling.transpose() * others.solve(coupling));
+}
+
+// x with P(chi-square, 3 degrees of freedom > x) = rate, by bisection of
+// the closed form erfc(sqrt(x / 2)) + sqrt(2 x / pi) e^(-x / 2).
+double chi_square_3_quantile_above(double rate) {
+  const auto tail = [](double x) { return std::erfc(std::sqrt(x / 2.0)) + std::sqrt(2.0 * x / M_PI) * std::exp(-x / 2.0); };
+  double low = 0.0, high = 200.0;
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (low + high);
+    (tail(mid) > rate ? low : high) = mid;
+  }
+  return 0.5 * (low + high);
 }
 
 }  // namespace
@@ -171,6 +208,8 @@ HealthWatch::HealthWatch(Robot robot, Calibration calibration, HealthWatchOption
       for (int a = 0; a < 3; ++a) baseline_information_(4 + 3 * i + a, 4 + 3 * i + a) = information(w.anchor_sigma(a));
     }
   }
+  tracked_information_ = baseline_information_;
+  anchor_margin_ = chi_square_3_quantile_above(std::clamp(options_.anchor_misnaming_rate, 1e-12, 1.0));
   // Siegmund: a one-sided CUSUM of Gaussian log likelihood ratios with
   // standardised shift delta crosses h, without change, after about
   // e^(h + 1.166 delta) / (delta^2 / 2) rests; Bonferroni over all of them.
@@ -252,6 +291,17 @@ RestCheck HealthWatch::add_rest(const Sample& rest) {
 }
 
 void HealthWatch::update_statistics(const RestInformation& info, RestCheck& out) {
+  // The calibration's error beta as the statistics see it: mean and
+  // covariance (zero and none when ignored).
+  Eigen::Matrix<double, kBaseline, 1> error_mean = Eigen::Matrix<double, kBaseline, 1>::Zero();
+  Eigen::Matrix<double, kBaseline, kBaseline> error_covariance = Eigen::Matrix<double, kBaseline, kBaseline>::Zero();
+  if (options_.calibration_error != CalibrationErrorHandling::kIgnored) {
+    const Eigen::LDLT<Eigen::Matrix<double, kBaseline, kBaseline>> ldlt(tracked_information_);
+    if (ldlt.info() == Eigen::Success && ldlt.isPositive()) {
+      error_covariance = ldlt.solve(Eigen::Matrix<double, kBaseline, kBaseline>::Identity());
+      error_mean = ldlt.solve(tracked_score_);
+    }
+  }
   int crossing = -1;
   double highest = threshold_;
   for (int j = 0; j < kFaultColumns; ++j) {
@@ -259,14 +309,21 @@ void HealthWatch::update_statistics(const RestInformation& info, RestCheck& out)
     const double I = info.information(j, j);
     if (!(I > 1e-12)) {
       s.z = 0.0;
+      s.standardised_shift = 0.0;
       continue;
     }
-    const double b = info.score(j), theta = shifts_[j];
-    s.z = b / std::sqrt(I);
-    const double drift = 0.5 * theta * theta * I;
+    // The innovation: the score less what the calibration's error predicts,
+    // with its variance including that prediction's uncertainty.
+    const Eigen::Matrix<double, 1, kBaseline> coupling = info.information.block<1, kBaseline>(j, 0);
+    const double b = info.score(j) - coupling * error_mean;
+    const double variance = I + coupling * error_covariance * coupling.transpose();
+    const double theta = shifts_[j], shift = theta * I;  // the score's mean under a change theta
+    s.z = b / std::sqrt(variance);
+    s.standardised_shift = shift / std::sqrt(variance);
+    const double drift = 0.5 * shift * shift / variance;
     // Page's CUSUM on the log likelihood ratio of +-theta against 0.
-    const double up = std::max(0.0, s.cusum_up + theta * b - drift);
-    const double down = std::max(0.0, s.cusum_down - theta * b - drift);
+    const double up = std::max(0.0, s.cusum_up + shift * b / variance - drift);
+    const double down = std::max(0.0, s.cusum_down - shift * b / variance - drift);
     if (s.cusum_up == 0.0 && up > 0.0) onset_up_[j] = info.rest;
     if (s.cusum_down == 0.0 && down > 0.0) onset_down_[j] = info.rest;
     s.cusum_up = up;
@@ -278,6 +335,13 @@ void HealthWatch::update_statistics(const RestInformation& info, RestCheck& out)
     }
   }
   out.statistics = statistics_;
+  const int tracking = options_.calibration_error_rests;
+  if (options_.calibration_error == CalibrationErrorHandling::kTracked && !finding_ &&
+      (tracking <= 0 || tracked_rests_ < tracking)) {
+    tracked_information_ += info.information.topLeftCorner<kBaseline, kBaseline>();
+    tracked_score_ += info.score.head<kBaseline>();
+    ++tracked_rests_;
+  }
   if (!finding_ && crossing >= 0) {
     StaleFinding f;
     f.statistic = statistics_[crossing];
@@ -318,8 +382,11 @@ void HealthWatch::attribute() {
   // margin; otherwise the slip, the simpler and commoner fault.
   if (f.term.term == FaultTerm::kCableElongation || f.term.term == FaultTerm::kAnchor) {
     for (const TermEstimate& e : f.candidates) {
-      if (e.term == FaultTerm::kEncoderOffset && e.cable == f.term.cable &&
-          f.term.aic_gain() - e.aic_gain() <= kAlikeAicMargin) {
+      const bool anchor_loses = f.term.term == FaultTerm::kAnchor &&
+                                f.term.chi_square_drop - e.chi_square_drop <= anchor_margin_;
+      const bool elongation_loses = f.term.term == FaultTerm::kCableElongation &&
+                                    f.term.aic_gain() - e.aic_gain() <= kAlikeAicMargin;
+      if (e.term == FaultTerm::kEncoderOffset && e.cable == f.term.cable && (anchor_loses || elongation_loses)) {
         f.term = e;
         break;
       }
@@ -330,6 +397,31 @@ void HealthWatch::attribute() {
     const bool same = e.term == f.term.term && e.cable == f.term.cable;
     if (!same && f.candidates.front().aic_gain() - e.aic_gain() <= kAlikeAicMargin) f.alike.push_back(e);
   }
+  f.anchor_or_offset = anchor_or_offset(before, since);
+}
+
+std::optional<AnchorOrOffset> HealthWatch::anchor_or_offset(const RestInformation& before,
+                                                            const RestInformation& since) const {
+  const StaleFinding& f = *finding_;
+  if (f.term.term != FaultTerm::kAnchor && f.term.term != FaultTerm::kEncoderOffset) return std::nullopt;
+  const TermEstimate *anchor = nullptr, *offset = nullptr;
+  for (const TermEstimate& e : f.candidates) {
+    if (e.cable != f.term.cable) continue;
+    if (e.term == FaultTerm::kAnchor) anchor = &e;
+    if (e.term == FaultTerm::kEncoderOffset) offset = &e;
+  }
+  const std::optional<Eigen::Matrix3d> beyond = anchor_beyond_offset(baseline_information_, before, since, f.term.cable);
+  if (!anchor || !offset || !beyond) return std::nullopt;
+  AnchorOrOffset out;
+  out.cable = f.term.cable;
+  out.log_likelihood_ratio = anchor->chi_square_drop - offset->chi_square_drop;
+  out.margin = anchor_margin_;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(*beyond);
+  const double best = eigen.eigenvalues().maxCoeff();
+  out.best_sigma_m = best > 0.0 ? 1.0 / std::sqrt(best) : std::numeric_limits<double>::infinity();
+  const Eigen::Vector3d move = anchor->value;
+  out.fitted_move_sigmas = std::sqrt(std::max(0.0, move.dot(*beyond * move)));
+  return out;
 }
 
 }  // namespace cdpr

@@ -25,6 +25,21 @@
 // strongly correlated, so the real rate is lower than designed. A change of
 // the designed size is flagged after about h / (theta_j^2 I_j / 2) rests.
 //
+// The committed calibration's own error beta (its anchors and offsets, off
+// within their covariance P0) shifts every rest's scores by A_j,beta beta,
+// the same error at every rest: a standing bias of the test (kIgnored, the
+// default; the designed rate assumes it small against theta_j / 2). With
+// kTracked the test runs on the innovations instead: beta estimated from the
+// rests so far (information P0^-1 + sum A_beta,beta, score sum b_beta), each
+// score less its prediction A_j,beta beta^ and normalised by its predictive
+// variance V_j = I_j + A_j,beta P A_beta,j. Tracked over every rest the
+// innovations are white (a Kalman filter's), so the designed rate holds
+// exactly whatever the calibration's error, but a change of an offset or
+// anchor is slowly learnt as calibration error; held after K rests it is
+// not, and the rate holds up to the error left after K rests. kPredictive
+// only widens V_j by P0. Measured (docs/operation.md): none of the three
+// flags a slip sooner than kIgnored; the flags are limited by delta.
+//
 // When a statistic crosses h the calibration is stale. The rests since the
 // crossing statistic last left zero (the change's onset) are refitted with
 // each candidate term (linearised, the per-rest pose and force eliminated),
@@ -37,8 +52,16 @@
 // kMimicAicMargin) of the best look alike and are listed. An elongation of a
 // cable or a move of its anchor is named over that cable's offset slip only
 // when it beats it by that margin: they differ only by how the payout and
-// the cable's direction vary over the rests. The finding is re-estimated
-// with every further rest.
+// the cable's direction vary over the rests. For an anchor against an
+// offset the margin is that of a likelihood-ratio test: the anchor is named
+// when 2 ln LR = (its chi-square drop - the offset's) exceeds the
+// chi-square (3 degrees of freedom) quantile of anchor_misnaming_rate
+// (default 1 %: 11.34): under a slip 2 ln LR is at most the chi-square of
+// adding the anchor to the offset, so at most that rate of slips are named
+// anchor moves. The finding says how well the rests span the cable's
+// directions (AnchorOrOffset): a move the rests cannot resolve beyond an
+// offset change is "looks alike", never an anchor. The finding is
+// re-estimated with every further rest.
 //
 // Term catalogue (the names of diagnose and of the calibration's keys):
 //   offset[i]         encoder offset slip of cable i                 [m]
@@ -70,6 +93,13 @@ enum class FaultTerm { kEncoderOffset, kAnchor, kCableElongation, kLoad, kLoadCe
 std::string fault_term_name(FaultTerm term, int cable);
 std::string fault_term_meaning(FaultTerm term, int cable);
 
+// How the sequential test treats the committed calibration's own error.
+enum class CalibrationErrorHandling {
+  kIgnored,     // the scores as they come: the error is a standing bias of the statistics
+  kPredictive,  // each score normalised by its variance including the calibration's covariance
+  kTracked,     // the error estimated from the rests so far; the test runs on the innovations
+};
+
 struct HealthWatchOptions {
   LocalizeOptions localize;  // the pose from the cables reported per rest (its max_chi_square applies to it alone)
   double height_sigma_m = 1e-2;  // Eq. (15), as the calibration's fit
@@ -89,6 +119,17 @@ struct HealthWatchOptions {
   // The calibration's joint covariance of anchors and offsets
   // (calibration_covariance.h); without it, its per-axis sigmas.
   std::optional<Eigen::Matrix<double, 4 * kCableCount, 4 * kCableCount>> calibration_covariance;
+  // What the statistics make of the committed calibration's own error
+  // (its anchors and offsets off within their covariance, the same at every
+  // rest); see the header comment and docs/operation.md.
+  CalibrationErrorHandling calibration_error = CalibrationErrorHandling::kIgnored;
+  // kTracked: the error is re-estimated over this many checked rests, then
+  // held; 0: over every rest, which keeps the innovations white.
+  int calibration_error_rests = 0;
+  // An anchor is named over its cable's offset when 2 ln LR exceeds the
+  // chi-square (3 degrees of freedom) quantile of this rate: at most this
+  // fraction of offset slips are named anchor moves (AnchorOrOffset).
+  double anchor_misnaming_rate = 0.01;
 };
 
 // One scalar statistic of the sequential test.
@@ -97,6 +138,9 @@ struct TermStatistic {
   int cable = -1;       // -1 for load and load_cell_bias
   int component = 0;    // anchor: world axis 0-2; load: 0 mass, 1-3 CoM
   double z = 0.0;       // this rest's normalised score s / sqrt(I) (N(0,1) when nothing changed)
+  // This rest's standardised shift delta: a change of the designed size
+  // moves z by this much (the CUSUM gains delta^2 / 2 a rest on average).
+  double standardised_shift = 0.0;
   double cusum_up = 0.0, cusum_down = 0.0;
   int onset_rest = -1;  // where the larger side last left zero (-1 while both are 0)
 };
@@ -129,6 +173,31 @@ struct TermEstimate {
   double aic_gain() const { return chi_square_drop - 2.0 * static_cast<double>(value.size()); }
 };
 
+// An anchor move against an offset slip of the same cable, over the rests
+// since the onset (the calibration's own error marginalised as for every
+// candidate). The two differ only through how the cable's direction varies
+// over the rests: a move along the cable is an offset change to every rest.
+struct AnchorOrOffset {
+  int cable = -1;
+  // 2 ln LR of anchor[i] over offset[i]: the difference of their chi-square
+  // drops. Under an offset slip it is at most the chi-square (3 degrees of
+  // freedom) of adding the anchor's move to the offset change.
+  double log_likelihood_ratio = 0.0;
+  double margin = 0.0;  // the anchor is named when 2 ln LR exceeds this (HealthWatchOptions::anchor_misnaming_rate)
+  // How well the rests span the cable's directions: the sigma of an anchor
+  // move in the direction these rests resolve best once an offset change
+  // may explain it too (infinite when none) [m]. A move smaller than about
+  // sqrt(margin) of these sigmas cannot win by the margin.
+  double best_sigma_m = 0.0;
+  // The fitted move's size in those sigmas: sqrt(d^T F d), F the anchor's
+  // information beyond the offset's; 2 ln LR is about its square.
+  double fitted_move_sigmas = 0.0;
+  bool anchor_named() const { return log_likelihood_ratio > margin; }
+  // The rests could tell a move of the fitted size from an offset: its
+  // expected 2 ln LR reaches the margin.
+  bool separable() const { return fitted_move_sigmas * fitted_move_sigmas >= margin; }
+};
+
 struct StaleFinding {
   int since_rest = 0;       // the change's onset (first rest of the fit)
   int since_sample_id = 0;
@@ -139,6 +208,8 @@ struct StaleFinding {
   TermEstimate term;        // the best by Akaike's criterion
   std::vector<TermEstimate> alike;       // others within 4 of it
   std::vector<TermEstimate> candidates;  // all, best first
+  // When the best candidate is an anchor or offset of a cable: which of the two.
+  std::optional<AnchorOrOffset> anchor_or_offset;
   bool calibration_fault() const { return term.term != FaultTerm::kLoad; }
 };
 
@@ -175,6 +246,7 @@ class HealthWatch {
  private:
   void update_statistics(const RestInformation& info, RestCheck& out);
   void attribute();
+  std::optional<AnchorOrOffset> anchor_or_offset(const RestInformation& before, const RestInformation& since) const;
 
   Robot robot_;
   Robot heavier_;  // the robot with a heavier platform: the load column by finite difference
@@ -186,6 +258,12 @@ class HealthWatch {
   std::vector<TermStatistic> statistics_;
   std::vector<double> shifts_;  // theta_j per statistic
   Eigen::Matrix<double, 16, 16> baseline_information_;  // the calibration's error: inverse covariance, column order
+  // kTracked: the information and score of the calibration's error so far
+  // (baseline_information_ plus the rests'), and how many rests fed them.
+  Eigen::Matrix<double, 16, 16> tracked_information_;
+  Eigen::Matrix<double, 16, 1> tracked_score_ = Eigen::Matrix<double, 16, 1>::Zero();
+  int tracked_rests_ = 0;
+  double anchor_margin_ = 0.0;  // 2 ln LR above which an anchor is named over the offset
   std::array<int, kFaultColumns> onset_up_{}, onset_down_{};  // where each side last left zero
   double threshold_ = 0.0;
   double reference_payout_m_ = 0.0;

@@ -56,6 +56,12 @@ TEST(SimRestSequence, AMovedAnchorAndAPayloadChangeTheTrueRobotFromTheirRest) {
   EXPECT_NEAR(heavier.robot.platform_mass_kg - moved.true_robot.robot.platform_mass_kg, 0.4, 1e-12);
 }
 
+TEST(SimRestSequence, AnAnchorMovesInTheChosenDirectionWhenGivenOne) {
+  InjectedFault up = fault(FaultKind::kAnchorMoved, 1, 0.05, 1);
+  up.direction_world = Eigen::Vector3d(0.0, 0.0, 2.0);
+  EXPECT_TRUE(rests_with(up, 2).anchor_shift_world.isApprox(Eigen::Vector3d(0.0, 0.0, 0.05)));
+}
+
 TEST(SimRestSequence, FaultNamesParse) {
   EXPECT_EQ(parse_fault_kind("slip"), FaultKind::kEncoderSlip);
   EXPECT_EQ(parse_fault_kind("creep"), FaultKind::kCableCreep);

@@ -88,6 +88,16 @@ void add_watch_command(CLI::App& app, WatchArgs& args) {
   cmd->add_option("--false-alarm-rests", args.clean_rests_per_false_alarm,
                   "designed false-alarm rate: at most one per this many clean rests")
       ->check(CLI::Range(10.0, 1e12))->capture_default_str();
+  cmd->add_option("--calibration-error", args.calibration_error,
+                  "the committed calibration's own error in the test: tracked (estimated from the rests so far, the "
+                  "test on the innovations), predictive (only the scores' variance widened by it) or ignored")
+      ->check(CLI::IsMember({"tracked", "predictive", "ignored"}))->capture_default_str();
+  cmd->add_option("--calibration-error-rests", args.calibration_error_rests,
+                  "tracked: estimate it over this many checked rests, then hold it (0: every rest)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  cmd->add_option("--anchor-misnaming-rate", args.anchor_misnaming_rate,
+                  "name an anchor move over its cable's offset slip only when at most this fraction of slips would be")
+      ->check(CLI::Range(1e-9, 0.5))->capture_default_str();
   cmd->add_flag("--no-measured-pose", args.no_measured_pose, "ignore the rows' onboard poses (cables and load cell only)");
   cmd->add_flag("-v,--verbose", args.verbose, "a line per rest: residuals and the largest statistic");
 }
@@ -98,6 +108,11 @@ int run_watch(const WatchArgs& args) {
   HealthWatchOptions options;
   options.clean_rests_per_false_alarm = args.clean_rests_per_false_alarm;
   options.use_measured_pose = !args.no_measured_pose;
+  options.calibration_error = args.calibration_error == "ignored"      ? CalibrationErrorHandling::kIgnored
+                              : args.calibration_error == "predictive" ? CalibrationErrorHandling::kPredictive
+                                                                       : CalibrationErrorHandling::kTracked;
+  options.calibration_error_rests = args.calibration_error_rests;
+  options.anchor_misnaming_rate = args.anchor_misnaming_rate;
   if (!args.calibration_samples_path.empty() &&
       !read_calibration_covariance(args.calibration_samples_path, *in, options.height_sigma_m, options.calibration_covariance)) {
     return 1;
@@ -106,12 +121,16 @@ int run_watch(const WatchArgs& args) {
   std::printf("health watch: %zu rests, threshold h = %.2f (at most one false alarm per %g clean rests)\n",
               in->rests.size(), watch.threshold(), args.clean_rests_per_false_alarm);
   int unchecked = 0;
+  double offset_shift_squares = 0.0;  // the offsets' delta^2 summed over the checked rests and cables
   for (const Sample& rest : in->rests) {
     const RestCheck check = watch.add_rest(rest);
     if (!check.checked) {
       ++unchecked;
       std::printf("rest %d (id %d): not checked: %s\n", check.rest, check.sample_id, check.why.c_str());
       continue;
+    }
+    for (const TermStatistic& s : check.statistics) {
+      if (s.term == FaultTerm::kEncoderOffset) offset_shift_squares += s.standardised_shift * s.standardised_shift;
     }
     if (args.verbose) {
       const TermStatistic* top = &check.statistics.front();
@@ -134,8 +153,16 @@ int run_watch(const WatchArgs& args) {
     }
   }
 
+  const int checked = static_cast<int>(in->rests.size()) - unchecked;
+  // The RMS standardised shift of a designed offset slip: the CUSUM needs
+  // about h / (delta^2 / 2) rests to flag one.
+  const double offset_delta = checked > 0 ? std::sqrt(offset_shift_squares / (kCableCount * checked)) : 0.0;
+  std::printf("a designed offset slip (%.3f m) moves a rest's score by %.2f sigma (RMS): flagged after about %.1f "
+              "rests\n",
+              options.offset_shift_m, offset_delta,
+              offset_delta > 0.0 ? watch.threshold() / (offset_delta * offset_delta / 2.0) : 0.0);
   std::string summary = "summary: rests=" + std::to_string(in->rests.size()) +
-                        " unchecked=" + std::to_string(unchecked);
+                        " unchecked=" + std::to_string(unchecked) + format(" offset_delta=%.2f", offset_delta, 0.0);
   if (!watch.stale()) {
     std::printf("the calibration held over %zu rests\n", in->rests.size());
     std::printf("%s stale=0\n", summary.c_str());
@@ -149,8 +176,20 @@ int run_watch(const WatchArgs& args) {
     alike += (alike.empty() ? "" : ",") + fault_term_name(e.term, e.cable);
   }
   if (!f.calibration_fault()) std::printf("  not a calibration fault: update robot.toml's mass and centre of mass\n");
+  if (const std::optional<AnchorOrOffset>& a = f.anchor_or_offset) {
+    std::printf("  anchor[%d] or offset[%d]: 2 ln LR %.1f (anchor named above %.1f): %s; the rests resolve a move "
+                "beyond an offset change to %.4f m (1 sigma) at best, the fitted move is %.1f of those sigmas%s\n",
+                a->cable, a->cable, a->log_likelihood_ratio, a->margin,
+                a->anchor_named() ? "the anchor" : "cannot tell, the offset is the simpler", a->best_sigma_m,
+                a->fitted_move_sigmas, a->separable() ? "" : " (too few for the margin: the rests do not span the "
+                                                              "cable's directions enough)");
+  }
   summary += " stale=1 fired_rest=" + std::to_string(f.fired_at_rest) + " onset_rest=" + std::to_string(f.since_rest) +
              " term=" + fault_term_name(f.term.term, f.term.cable) + " alike=" + (alike.empty() ? "-" : alike);
+  if (const std::optional<AnchorOrOffset>& a = f.anchor_or_offset) {
+    summary += format(" anchor_2lnlr=%.1f anchor_move_sigmas=%.1f", a->log_likelihood_ratio, a->fitted_move_sigmas) +
+               format(" anchor_best_sigma_m=%.4f", a->best_sigma_m, 0.0);
+  }
 
   RefitRequest request = refit_request_for(f);
   if (args.offsets_only) request.offsets_only = true;

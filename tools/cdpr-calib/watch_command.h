@@ -22,6 +22,9 @@ struct WatchArgs {
   bool verbose = false;
   bool no_measured_pose = false;
   double clean_rests_per_false_alarm = 1e3;
+  std::string calibration_error = "ignored";  // ignored, predictive or tracked (HealthWatchOptions)
+  int calibration_error_rests = 0;
+  double anchor_misnaming_rate = 0.01;
 };
 
 void add_watch_command(CLI::App& app, WatchArgs& args);

@@ -77,7 +77,8 @@ Expected<RestSequence, std::string> simulate_rest_sequence(const RestSequenceCon
   out.nominal = base->nominal;
   out.true_robot = base->true_robot;
   Rng direction = Rng::stream(config.robot.seed, kStreamFaultDirection);
-  out.anchor_shift_world = config.fault.size * random_direction(direction);
+  const Eigen::Vector3d& chosen = config.fault.direction_world;
+  out.anchor_shift_world = config.fault.size * (chosen.norm() > 0.0 ? chosen.normalized() : random_direction(direction));
 
   const PresetSpec spec = preset_spec(config.robot.preset);
   WaypointSequence waypoints(spec, config.robot.seed ^ kRestWaypointSeedSalt);

@@ -35,6 +35,7 @@ struct InjectedFault {
   int cable = 0;
   double size = 0.0;  // m (slip, anchor, creep) or kg (payload)
   Eigen::Vector3d com_shift_platform = Eigen::Vector3d::Zero();  // payload
+  Eigen::Vector3d direction_world = Eigen::Vector3d::Zero();     // anchor: the move's direction (zero: random)
   int ramp_rests = 10;  // creep
 };
 
