@@ -16,6 +16,12 @@ namespace {
 std::string unreadable_reason(const std::string& path) {
   std::error_code error;
   const auto status = std::filesystem::status(path, error);
+  if (error && !std::filesystem::exists(status)) {
+    // The usual cause: a file the daemon's unit cannot see (systemd/cdpr-calibd.service).
+    return path + ": " + error.message() +
+           " (the daemon reads it as its own user in its sandbox, which hides /home and /root and has its own "
+           "/tmp and /var/tmp)";
+  }
   if (error) return path + ": " + error.message();
   if (!std::filesystem::is_regular_file(status)) return path + ": not a regular file";
   const std::uintmax_t bytes = std::filesystem::file_size(path, error);

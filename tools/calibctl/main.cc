@@ -1,6 +1,6 @@
-// calibctl: the operator's client of cdpr-calibd's control socket. Starts and
-// aborts a field calibration (planned, or through a waypoints file), shows its progress, the current calibration,
-// the stored versions, rolls back to one of them, retries a commit that
+// calibctl: the operator's client of cdpr-calibd's control socket. Starts
+// (planned, or through a waypoints file) and aborts a field calibration,
+// shows its progress, the current calibration, the stored versions, rolls back to one of them, retries a commit that
 // failed, and commits a kept run refitted with an extra model term.
 //
 // Exit status: 0 done; 1 the daemon refused the request (or, with
