@@ -91,6 +91,7 @@ bool CalibrationStateMachine::request_start(hal::TimeUs now_us, std::optional<Gi
     // The earlier run's rows first: the fit and the run's samples.csv hold them and the new poses.
     samples_ = std::move(given_->earlier_samples);
     given_->earlier_samples.clear();
+    given_->earlier_rows = samples_.size();
   }
   solve_result_.reset();
   fit_validated_ = false;
@@ -568,8 +569,14 @@ void CalibrationStateMachine::next_waypoint(hal::TimeUs now_us) {
   }
   if (const hal::Status s = devices_.winches.halt(); !s.ok()) return fail("halt: " + s.to_string(), now_us, true);
   if (static_cast<int>(samples_.size()) < options_.validation.min_samples) {
-    return fail("only " + std::to_string(samples_.size()) + " of " + std::to_string(waypoints_.visited()) +
-                    " waypoints settled (at least " + std::to_string(options_.validation.min_samples) + " needed)",
+    // An appended-to run's rows count towards the minimum, but they did not settle here.
+    const std::size_t earlier = given_ ? given_->earlier_rows : 0;
+    return fail("only " + std::to_string(samples_.size() - earlier) + " of " + std::to_string(waypoints_.visited()) +
+                    " waypoints settled (at least " + std::to_string(options_.validation.min_samples) + " needed" +
+                    (earlier > 0 ? ", counting the " + std::to_string(earlier) + " rows of run " +
+                                       std::to_string(given_->earlier_run)
+                                 : std::string()) +
+                    ")",
                 now_us, false);
   }
   enter(CalibrationState::kSolve, now_us);

@@ -26,6 +26,7 @@ struct GivenWaypoints {
   // run's fit and its samples.csv hold them and then the new poses. Empty: the new poses alone.
   std::vector<Sample> earlier_samples;
   int earlier_run = 0;  // the run they are from; 0 when none
+  std::size_t earlier_rows = 0;  // how many there were (the state machine moves the rows out)
 };
 
 }  // namespace cdpr::calibration

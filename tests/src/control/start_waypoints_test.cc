@@ -147,6 +147,27 @@ TEST(StartWaypoints, AMissingOrMalformedFileIsRefusedNamingFileLineAndColumn) {
   expect_idle_and_untouched(rig);
 }
 
+TEST(StartWaypoints, TooFewRowsForTheFitEndTheRunAfterMeasuringThemCountingTheEarlierRows) {
+  // GIVEN validation needs 4 rows, a kept run of one row and a file of two poses
+  CalibrationRig rig;
+  std::vector<Sample> earlier(1);
+  earlier[0].position_world = Eigen::Vector3d(100.0, 100.0, 20.0);
+  keep_run(rig, 5, rig.robot, earlier);
+  const std::string path = waypoints_file(rig, feasible_positions(rig, 2));
+  // WHEN the file alone is run THEN the run fails after both were sampled, saying how many settled
+  ASSERT_TRUE(contains(ask(rig, "start waypoints " + path), "\"ok\":true"));
+  ASSERT_TRUE(rig.run_to_end());
+  EXPECT_EQ(rig.status().state, CalibrationState::kFailed);
+  EXPECT_TRUE(contains(rig.status().reason, "only 2 of 2 waypoints settled (at least 4 needed) (")) << rig.status().reason;
+  // AND appended to run 5 the earlier row counts, and the reason says so
+  ASSERT_TRUE(contains(ask(rig, "start waypoints " + path + " 5"), "\"ok\":true"));
+  ASSERT_TRUE(rig.run_to_end());
+  EXPECT_TRUE(contains(rig.status().reason,
+                       "only 2 of 2 waypoints settled (at least 4 needed, counting the 1 rows of run 5) ("))
+      << rig.status().reason;
+  EXPECT_EQ(rig.machine->samples().size(), 3u);
+}
+
 TEST(StartWaypoints, AWaypointOutsideTheWorkspaceRefusesTheWholeRequest) {
   // GIVEN a file whose second waypoint is above the z band (5..35 m)
   CalibrationRig rig;
