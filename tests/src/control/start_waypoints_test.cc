@@ -98,6 +98,24 @@ TEST(StartWaypoints, ARunDrivesExactlyTheWaypointsGivenInTheirOrder) {
   }
 }
 
+TEST(StartWaypoints, AnAbortStopsARunThroughAFileAsAPlannedOne) {
+  // GIVEN a run through four waypoints, the winches travelling to the second
+  CalibrationRig rig;
+  ASSERT_TRUE(contains(ask(rig, "start waypoints " + waypoints_file(rig, feasible_positions(rig, 4))), "\"ok\":true"));
+  ASSERT_TRUE(rig.run_to_moving(2));
+  // WHEN the operator aborts THEN the winches stop, the run ends aborted, the old calibration stays
+  EXPECT_TRUE(contains(ask(rig, "abort"), "\"ok\":true"));
+  EXPECT_EQ(rig.status().state, CalibrationState::kAborted);
+  EXPECT_GE(rig.winches.halts(), 1);
+  rig.run_until([] { return false; }, 2'000'000);
+  EXPECT_TRUE(rig.winches.all_stopped());
+  EXPECT_TRUE(rig.previous_calibration_intact());
+  // AND a plain start afterwards plans again (the file is not remembered)
+  ASSERT_TRUE(contains(ask(rig, "start"), "\"ok\":true"));
+  ASSERT_TRUE(rig.run_to(CalibrationState::kMove, 1));
+  EXPECT_EQ(rig.status().strategy, "spread");
+}
+
 TEST(StartWaypoints, AppendedToARunTheDataAreItsRowsThenTheNewPoses) {
   // GIVEN a kept run of five rows of this robot, and a file of two feasible poses
   CalibrationRig rig;
