@@ -52,7 +52,7 @@ void CalibrationStateMachine::enter(CalibrationState state, hal::TimeUs now_us) 
   status_.detail.clear();
 }
 
-bool CalibrationStateMachine::request_start(hal::TimeUs now_us) {
+bool CalibrationStateMachine::request_start(hal::TimeUs now_us, std::optional<GivenWaypoints> given) {
   if (is_running(status_.state)) {
     status_.note = std::string("start ignored: a calibration is already running (") + to_string(status_.state) +
                    (status_.waypoint_count > 0
@@ -65,6 +65,12 @@ bool CalibrationStateMachine::request_start(hal::TimeUs now_us) {
     // Its result would land in the new run: wait until the worker is done.
     status_.note = "start refused: the last run's waypoint planning is still finishing, try again";
     return false;
+  }
+  if (given) {
+    if (const std::string why = given_waypoints_problem(*given); !why.empty()) {
+      status_.note = "start refused: " + why;
+      return false;
+    }
   }
   CalibrationStatus fresh;
   fresh.store_problems = std::move(status_.store_problems);
@@ -80,6 +86,13 @@ bool CalibrationStateMachine::request_start(hal::TimeUs now_us) {
   after_job_ = AfterJob::kNone;
   job_waypoint_.reset();
   samples_.clear();
+  given_ = std::move(given);
+  if (given_) {
+    // The earlier run's rows first: the fit and the run's samples.csv hold them and the new poses.
+    samples_ = std::move(given_->earlier_samples);
+    given_->earlier_samples.clear();
+    given_->earlier_rows = samples_.size();
+  }
   solve_result_.reset();
   fit_validated_ = false;
   monitor_.reset();
@@ -87,10 +100,33 @@ bool CalibrationStateMachine::request_start(hal::TimeUs now_us) {
   run_log_ = formats::RunLog{};
   run_log_.robot = robot_.name;
   if (utc_now_text_) run_log_.started = utc_now_text_();
+  if (given_) {
+    run_log_.extends = given_->earlier_run;
+    status_.samples = run_log_.samples = static_cast<int>(samples_.size());
+    status_.note = "started: " + std::to_string(given_->positions_world.size()) + " waypoints from " + given_->source +
+                   (given_->earlier_run > 0 ? " after the " + std::to_string(samples_.size()) + " samples of run " +
+                                                  std::to_string(given_->earlier_run)
+                                            : std::string());
+  }
   log_run(now_us, formats::kRunRunning);
   enter(CalibrationState::kPreflight, now_us);
   update_progress();
   return true;
+}
+
+std::string CalibrationStateMachine::given_waypoints_problem(const GivenWaypoints& given) const {
+  const std::size_t count = given.positions_world.size();
+  if (count == 0) return given.source + " has no waypoints";
+  if (count > kMaxGivenWaypoints) {
+    return given.source + " has " + std::to_string(count) + " waypoints, at most " +
+           std::to_string(kMaxGivenWaypoints) + " are taken";
+  }
+  for (std::size_t k = 0; k < count; ++k) {
+    if (const std::string why = outside_workspace(robot_, given.positions_world[k], options_.planner); !why.empty()) {
+      return given.source + " waypoint " + std::to_string(k + 1) + " of " + std::to_string(count) + ": " + why;
+    }
+  }
+  return {};
 }
 
 bool CalibrationStateMachine::request_reset_faults(hal::TimeUs now_us) {
@@ -361,6 +397,16 @@ void CalibrationStateMachine::run_plan(hal::TimeUs now_us) {
   SequentialOptions sequential = options_.sequential;
   sequential.min_count = options_.validation.min_samples;
   sequential.settle_s = expected_settle_s(options_.equilibrium);
+  if (given_) {
+    begin_job(AfterJob::kPlanned,
+              [planning_robot, offsets_m, start_world, planner = options_.planner,
+               positions = given_->positions_world, sequential, now_us](WaypointSequence& waypoints) {
+                return waypoints.start_given(planning_robot, offsets_m, start_world, planner, positions, sequential,
+                                             now_us);
+              },
+              now_us);
+    return;
+  }
   begin_job(AfterJob::kPlanned,
             [planning_robot, offsets_m, start_world, planner = options_.planner, strategy = options_.strategy,
              sequential, now_us](WaypointSequence& waypoints) {
@@ -442,7 +488,8 @@ void CalibrationStateMachine::run_settle(hal::TimeUs now_us) {
 void CalibrationStateMachine::run_sample(hal::TimeUs now_us) {
   Sample sample = detector_.average();
   sample.sigma = detector_.average_sigmas(robot_.noise);
-  sample.id = static_cast<int>(samples_.size());
+  // After an earlier run's rows (given waypoints) the ids go on from theirs.
+  sample.id = samples_.empty() ? 0 : samples_.back().id + 1;
   samples_.push_back(sample);
   status_.samples = static_cast<int>(samples_.size());
   begin_job(AfterJob::kSampled,
@@ -522,8 +569,14 @@ void CalibrationStateMachine::next_waypoint(hal::TimeUs now_us) {
   }
   if (const hal::Status s = devices_.winches.halt(); !s.ok()) return fail("halt: " + s.to_string(), now_us, true);
   if (static_cast<int>(samples_.size()) < options_.validation.min_samples) {
-    return fail("only " + std::to_string(samples_.size()) + " of " + std::to_string(waypoints_.visited()) +
-                    " waypoints settled (at least " + std::to_string(options_.validation.min_samples) + " needed)",
+    // An appended-to run's rows count towards the minimum, but they did not settle here.
+    const std::size_t earlier = given_ ? given_->earlier_rows : 0;
+    return fail("only " + std::to_string(samples_.size() - earlier) + " of " + std::to_string(waypoints_.visited()) +
+                    " waypoints settled (at least " + std::to_string(options_.validation.min_samples) + " needed" +
+                    (earlier > 0 ? ", counting the " + std::to_string(earlier) + " rows of run " +
+                                       std::to_string(given_->earlier_run)
+                                 : std::string()) +
+                    ")",
                 now_us, false);
   }
   enter(CalibrationState::kSolve, now_us);
@@ -637,7 +690,7 @@ const Waypoint* CalibrationStateMachine::current_waypoint() const {
 }
 
 void CalibrationStateMachine::update_waypoint_status() {
-  status_.strategy = run_log_.strategy = to_string(waypoints_.strategy());
+  status_.strategy = run_log_.strategy = waypoints_.strategy_name();
   status_.stop_reason = run_log_.stop = waypoints_.stop_reason();
   status_.target_anchor_sigma_m = options_.sequential.target_anchor_sigma_m;
   status_.target_offset_sigma_m = options_.sequential.target_offset_sigma_m;

@@ -91,6 +91,7 @@
 #include "src/calibration/calibration_state.h"
 #include "src/calibration/equilibrium_detector.h"
 #include "src/calibration/fit_validation.h"
+#include "src/calibration/given_waypoints.h"
 #include "src/calibration/hardware_monitor.h"
 #include "src/calibration/waypoint_job.h"
 #include "src/calibration/waypoint_planner.h"
@@ -149,8 +150,17 @@ class CalibrationStateMachine {
   void step(hal::TimeUs now_us);
 
   // Starts a run when not running; otherwise ignored with a note. Returns
-  // whether a run was started. Same effect as a button press.
-  bool request_start(hal::TimeUs now_us);
+  // whether a run was started. Same effect as a button press. With `given`
+  // the run drives exactly those waypoints instead of a plan (its strategy
+  // "given"), with the same preflight, limits, equilibrium wait, validation
+  // and stops as a planned run, and its samples begin with
+  // given->earlier_samples. Refused (note says why) when they are more than
+  // kMaxGivenWaypoints or one lies outside the planner's workspace box; the
+  // rest of the planner's checks (a rest within the tension band, the sag
+  // and travel limits, on the anchors and offsets the run plans with) come
+  // in plan, where the first waypoint that fails them fails the run before
+  // the drives are enabled.
+  bool request_start(hal::TimeUs now_us, std::optional<GivenWaypoints> given = std::nullopt);
   // Aborts a run in progress (winches halted, old calibration kept). Returns
   // false (and notes it) when nothing is running.
   // The operator's request to clear the devices' latched faults (calibctl
@@ -213,6 +223,8 @@ class CalibrationStateMachine {
   const CalibrationResult* validated_result() const { return fit_validated_ ? &*solve_result_ : nullptr; }
 
   const CalibrationStatus& status() const { return status_; }
+  // The nominal robot the runs calibrate.
+  const Robot& robot() const { return robot_; }
   // The fixed plan's waypoints in travel order, or the sequential strategy's
   // candidates; empty while a waypoint job is away.
   const WaypointPlan& plan() const { return waypoints_.plan(); }
@@ -224,6 +236,8 @@ class CalibrationStateMachine {
   // Ends the run in `end` (kFailed, or kAborted for an abort request).
   void fail(const std::string& reason, hal::TimeUs now_us, bool fault, CalibrationState end = CalibrationState::kFailed);
   void poll_button(hal::TimeUs now_us);
+  // Why `given` cannot start a run (count, workspace box); empty when it can.
+  std::string given_waypoints_problem(const GivenWaypoints& given) const;
   // status().device_faults from the winch bank's latched faults.
   void refresh_device_faults();
   // status().nodes from the winch bank (sized once; no allocation after).
@@ -268,6 +282,7 @@ class CalibrationStateMachine {
   std::optional<hal::TimeUs> enable_sent_us_;  // when the drives were commanded on (the plan exists)
   bool store_probed_ = false;                  // at the run's first step (preflight)
   std::optional<store::CurrentCalibration> previous_;
+  std::optional<GivenWaypoints> given_;  // the run's waypoints when given (positions; rows moved to samples_)
   WaypointSequence waypoints_;
   std::optional<WaypointJob> job_;       // begun, not taken yet (kByOwner)
   bool job_out_ = false;                 // taken, not delivered yet (outlives its run)

@@ -191,6 +191,56 @@ WaypointPlan plan_waypoints(const Robot& robot, const std::array<double, kCableC
   return plan;
 }
 
+std::string outside_workspace(const Robot& robot, const Eigen::Vector3d& position_world,
+                              const PlannerOptions& options) {
+  const Box box = workspace_box(robot, options);
+  static constexpr const char* kAxis[] = {"x", "y", "z"};
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!(position_world(axis) >= box.low(axis) && position_world(axis) <= box.high(axis))) {
+      return std::string(kAxis[axis]) + " " + significant(position_world(axis)) + " m outside the workspace [" +
+             significant(box.low(axis)) + ", " + significant(box.high(axis)) + "] m";
+    }
+  }
+  return {};
+}
+
+WaypointPlan given_waypoints(const Robot& robot, const std::array<double, kCableCount>& payout_offset_m,
+                             const std::vector<Eigen::Vector3d>& positions_world, const PlannerOptions& options) {
+  WaypointPlan plan;
+  plan.problem = check_planner_options(robot, options);
+  if (!plan.ok()) return plan;
+  if (positions_world.empty()) {
+    plan.problem = "no waypoints given";
+    return plan;
+  }
+  const auto anchors = nominal_anchors(robot);
+  for (std::size_t k = 0; k < positions_world.size(); ++k) {
+    const Eigen::Vector3d& position = positions_world[k];
+    const std::string which = "waypoint " + std::to_string(k + 1) + " of " + std::to_string(positions_world.size()) +
+                              " (x " + significant(position.x()) + ", y " + significant(position.y()) + ", z " +
+                              significant(position.z()) + "): ";
+    std::string why = outside_workspace(robot, position, options);
+    std::optional<StaticPose> rest;
+    if (why.empty()) rest = solve_static_pose(robot, anchors, position, &why);
+    Waypoint waypoint;
+    if (rest) {
+      waypoint.rest = std::move(*rest);
+      for (int i = 0; i < kCableCount; ++i) waypoint.payout_m[i] = waypoint.rest.arc_length_m[i] + payout_offset_m[i];
+      why = limit_violation(robot, anchors, waypoint.rest, waypoint.payout_m, options);
+    } else if (why.empty()) {
+      why = "no rest pose";
+    }
+    if (!why.empty()) {
+      plan.rejected.push_back({position, why});
+      plan.waypoints.clear();
+      plan.problem = which + why;
+      return plan;
+    }
+    plan.waypoints.push_back(std::move(waypoint));
+  }
+  return plan;
+}
+
 Expected<std::array<double, kCableCount>, std::string> estimate_payout_offsets(
     const Robot& robot, const Eigen::Vector3d& position_world, const std::array<double, kCableCount>& encoder_m) {
   std::string no_rest;

@@ -112,6 +112,20 @@ std::vector<int> spread_waypoints(const std::vector<Waypoint>& candidates, const
 WaypointPlan plan_waypoints(const Robot& robot, const std::array<double, kCableCount>& payout_offset_m,
                             const Eigen::Vector3d& start_world, const PlannerOptions& options);
 
+// Why `position_world` lies outside the planner's workspace box (the
+// anchors' footprint inset by margin_m, the z band); empty when inside.
+std::string outside_workspace(const Robot& robot, const Eigen::Vector3d& position_world,
+                              const PlannerOptions& options);
+
+// The given positions as waypoints, in the order given: each must lie in the
+// workspace box and pass the checks of a planned candidate (a rest, the
+// tension band, the sag, the travel limits). The first that does not makes
+// the plan's `problem` ("waypoint 3 of 8 (x 120, y 20, z 35): cable 2
+// tension 4.1 N below 20 N") and leaves `waypoints` empty: a run drives all
+// of them or none. waypoint_count, grid and selection are not used.
+WaypointPlan given_waypoints(const Robot& robot, const std::array<double, kCableCount>& payout_offset_m,
+                             const std::vector<Eigen::Vector3d>& positions_world, const PlannerOptions& options);
+
 // Encoder offsets from one measured rest pose: reading - modelled arc length
 // at that position (its rest orientation, nominal anchors).
 Expected<std::array<double, kCableCount>, std::string> estimate_payout_offsets(

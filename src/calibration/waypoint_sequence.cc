@@ -42,6 +42,22 @@ std::string WaypointSequence::start(const Robot& robot, const std::array<double,
   return "";
 }
 
+std::string WaypointSequence::start_given(const Robot& robot, const std::array<double, kCableCount>& offset_m,
+                                          const Eigen::Vector3d& start_world, const PlannerOptions& planner,
+                                          const std::vector<Eigen::Vector3d>& positions_world,
+                                          const SequentialOptions& sequential, hal::TimeUs now_us) {
+  *this = WaypointSequence{};
+  given_ = true;
+  robot_ = robot;
+  sequential_options_ = sequential;
+  start_pose_ = at_ = Pose{start_world, Eigen::Quaterniond::Identity()};
+  started_us_ = estimated_at_us_ = now_us;
+  plan_ = given_waypoints(robot, offset_m, positions_world, planner);
+  if (!plan_.ok()) return plan_.problem;
+  time_left_s_ = modelled_left_s();
+  return "";
+}
+
 int WaypointSequence::planned() const {
   return sequential_ ? sequential_options_.max_count : static_cast<int>(plan_.waypoints.size());
 }

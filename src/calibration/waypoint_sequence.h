@@ -43,6 +43,14 @@ class WaypointSequence {
                     const Eigen::Vector3d& start_world, const PlannerOptions& planner, WaypointStrategy strategy,
                     const SequentialOptions& sequential, hal::TimeUs now_us);
 
+  // A run through exactly `positions_world`, in that order
+  // (given_waypoints(): all pass the planner's checks or the run has none).
+  // strategy_name() is then "given". Returns what is wrong, else "".
+  std::string start_given(const Robot& robot, const std::array<double, kCableCount>& offset_m,
+                          const Eigen::Vector3d& start_world, const PlannerOptions& planner,
+                          const std::vector<Eigen::Vector3d>& positions_world, const SequentialOptions& sequential,
+                          hal::TimeUs now_us);
+
   // The waypoint to drive to next; null when the run's waypoints are done.
   const Waypoint* current() const;
   // The current waypoint was sampled / could not be (no rest, skipped).
@@ -50,6 +58,8 @@ class WaypointSequence {
   void skipped(hal::TimeUs now_us);
 
   WaypointStrategy strategy() const { return strategy_; }
+  // For status and the run log: the strategy's name, or "given".
+  const char* strategy_name() const { return given_ ? "given" : to_string(strategy_); }
   // Waypoints planned: the fixed plan's size, or the sequential maximum.
   int planned() const;
   // Waypoints sampled or skipped so far.
@@ -84,6 +94,7 @@ class WaypointSequence {
   double modelled_left_s() const;
 
   WaypointStrategy strategy_ = WaypointStrategy::kSpread;
+  bool given_ = false;  // start_given(): a fixed plan of the positions given
   Robot robot_;
   SequentialOptions sequential_options_;
   WaypointPlan plan_;                          // fixed plan, or the candidates

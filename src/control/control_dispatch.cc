@@ -2,6 +2,7 @@
 
 #include "src/control/control_request.h"
 #include "src/control/control_response.h"
+#include "src/control/start_waypoints.h"
 
 namespace cdpr::control {
 
@@ -11,9 +12,20 @@ std::string respond(std::string_view request_line, calibration::CalibrationState
   const auto request = parse_request(request_line);
   if (!request) return format_error_response(request.error());
   switch (request->kind) {
-    case RequestKind::kStart:
-      if (!machine.request_start(now_us)) return format_error_response(machine.status().note);
-      return format_ok_response("started");
+    case RequestKind::kStart: {
+      std::optional<calibration::GivenWaypoints> given;
+      if (!request->waypoints_path.empty()) {
+        if (calibration::is_running(machine.status().state)) {
+          return format_error_response("start refused: a calibration is already running");
+        }
+        auto loaded = load_start_waypoints(request->waypoints_path, request->run, store.history_dir(), machine.robot());
+        if (!loaded) return format_error_response("start refused: " + loaded.error());
+        given = std::move(*loaded);
+      }
+      const bool with_waypoints = given.has_value();
+      if (!machine.request_start(now_us, std::move(given))) return format_error_response(machine.status().note);
+      return format_ok_response(with_waypoints ? machine.status().note : std::string("started"));
+    }
     case RequestKind::kAbort:
       if (!machine.request_abort(now_us, "abort requested on the control socket")) {
         return format_error_response(machine.status().note);

@@ -5,6 +5,8 @@
 // passed in. Never throws; every outcome is one response line
 // (control_response.h).
 //
+// `start waypoints <path> [<run>]` reads and checks the file and the run
+// (start_waypoints.h) before the machine is asked to start.
 // rollback and commit are refused while a calibration runs (the run's
 // validation compares against the current file and its commit would
 // overwrite theirs). commit commits the fit a failed commit kept (in the

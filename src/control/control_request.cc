@@ -25,7 +25,8 @@ constexpr std::array<Command, 9> kCommands = {{
 }};
 
 constexpr const char* kExpected =
-    "expected start, abort, status, show, history, rollback <seq>, commit, reset-faults or refit <terms> [<run>]";
+    "expected start [waypoints <path> [<run>]], abort, status, show, history, rollback <seq>, commit, reset-faults or "
+    "refit <terms> [<run>]";
 
 bool is_blank(char c) { return c == ' ' || c == '\t'; }
 
@@ -48,17 +49,38 @@ int positive_number(std::string_view digits) {
   return number;
 }
 
-// `refit <terms> [<run>]`: the run as 7 or as its entry name run-000007.
+// A run as 7 or as its entry name run-000007; 0 when it is neither.
+int run_number(std::string_view run) {
+  if (run.starts_with("run-")) run.remove_prefix(4);
+  return positive_number(run);
+}
+
+// `refit <terms> [<run>]`.
 Expected<Request, std::string> parse_refit(const std::vector<std::string_view>& words) {
   if (words.size() < 2 || words.size() > 3) {
     return Unexpected{std::string("refit takes one or two arguments: <terms> [<run>]")};
   }
-  Request request{RequestKind::kRefit, 0, std::string(words[1]), 0};
+  Request request{RequestKind::kRefit, 0, std::string(words[1]), 0, {}};
   if (words.size() == 3) {
-    std::string_view run = words[2];
-    if (run.starts_with("run-")) run.remove_prefix(4);
-    request.run = positive_number(run);
+    request.run = run_number(words[2]);
     if (request.run < 1) return Unexpected{"run " + quoted(words[2]) + " is not a run number (7 or run-000007)"};
+  }
+  return request;
+}
+
+// `start` or `start waypoints <path> [<run>]`. The path is absolute: the
+// daemon's working directory is not the client's.
+Expected<Request, std::string> parse_start(const std::vector<std::string_view>& words) {
+  Request request{RequestKind::kStart, 0, {}, 0, {}};
+  if (words.size() == 1) return request;
+  if (words[1] != "waypoints" || words.size() < 3 || words.size() > 4) {
+    return Unexpected{std::string("start takes no argument or: waypoints <path> [<run>]")};
+  }
+  if (!words[2].starts_with('/')) return Unexpected{"waypoints path " + quoted(words[2]) + " is not absolute"};
+  request.waypoints_path = std::string(words[2]);
+  if (words.size() == 4) {
+    request.run = run_number(words[3]);
+    if (request.run < 1) return Unexpected{"run " + quoted(words[3]) + " is not a run number (7 or run-000007)"};
   }
   return request;
 }
@@ -93,16 +115,17 @@ Expected<Request, std::string> parse_request(std::string_view line) {
   if (words.empty()) return Unexpected{std::string("empty request (") + kExpected + ")"};
 
   if (words[0] == "refit") return parse_refit(words);
+  if (words[0] == "start") return parse_start(words);
   for (const Command& command : kCommands) {
     if (words[0] != command.name) continue;
     if (!command.takes_seq) {
       if (words.size() != 1) return Unexpected{std::string(command.name) + " takes no argument"};
-      return Request{command.kind, 0, {}, 0};
+      return Request{command.kind, 0, {}, 0, {}};
     }
     if (words.size() != 2) return Unexpected{std::string(command.name) + " takes one argument: <seq>"};
     const int seq = positive_number(words[1]);
     if (seq < 1) return Unexpected{"sequence number " + quoted(words[1]) + " is not an integer in 1..999999999"};
-    return Request{command.kind, seq, {}, 0};
+    return Request{command.kind, seq, {}, 0, {}};
   }
   return Unexpected{"unknown command " + quoted(words[0]) + " (" + kExpected + ")"};
 }

@@ -7,6 +7,10 @@
 // separated by single or repeated spaces or tabs:
 //
 //   start            start a calibration (as the button)
+//   start waypoints <path> [<run>]  a calibration through exactly the
+//                    waypoints of the waypoints.csv at <path> (absolute, no
+//                    blanks; read by the daemon), its data appended to run
+//                    <run>'s samples when given (7 or run-000007)
 //   abort            abort the calibration in progress
 //   status           state, waypoint k/N, progress, reasons
 //   show             the current calibration
@@ -45,6 +49,8 @@ struct Request {
   // daemon, which names them in its refusal) and the run, 0 for the newest.
   std::string terms;
   int run = 0;
+  // kStart with waypoints: the file (absolute); `run` the run to append to, 0 for none.
+  std::string waypoints_path;
 };
 
 // Parses one line (with or without its "\n"). The error is a short reason

@@ -25,6 +25,7 @@ RunLog read_run_log(TomlReader& reader, const toml::table& root) {
                      {"stop", Presence::kOptional}, {"samples", Presence::kRequired},
                      {"skipped", Presence::kRequired}, {"calibration", Presence::kOptional},
                      {"diagnosis", Presence::kOptional}, {"refit_of", Presence::kOptional},
+                     {"extends", Presence::kOptional},
                      {"waypoint", Presence::kOptional},
                      {"fault", Presence::kOptional}});
   RunLog log;
@@ -52,6 +53,7 @@ RunLog read_run_log(TomlReader& reader, const toml::table& root) {
   if (root.contains("calibration")) log.calibration = reader.count(root, "calibration", "");
   if (root.contains("diagnosis")) log.diagnosis = reader.string(root, "diagnosis", "");
   if (root.contains("refit_of")) log.refit_of = reader.count(root, "refit_of", "");
+  if (root.contains("extends")) log.extends = reader.count(root, "extends", "");
   // Absent arrays are empty: a run that ended before its first waypoint, a run without faults.
   const auto tables = [&](const char* key) {
     return root.contains(key) ? reader.tables(root, key, "") : std::vector<const toml::table*>{};
@@ -98,6 +100,7 @@ std::string format_run_log_toml(const RunLog& log) {
   if (log.calibration > 0) append_line(out, "calibration = " + std::to_string(log.calibration), "history sequence number");
   if (!log.diagnosis.empty()) append_line(out, "diagnosis = " + toml_string(log.diagnosis));
   if (log.refit_of > 0) append_line(out, "refit_of = " + std::to_string(log.refit_of), "the run whose samples were refitted");
+  if (log.extends > 0) append_line(out, "extends = " + std::to_string(log.extends), "samples.csv begins with this run's samples");
   for (const RunWaypoint& waypoint : log.waypoints) {
     out += '\n';
     append_line(out, "[[waypoint]]");

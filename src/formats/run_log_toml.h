@@ -55,6 +55,9 @@ struct RunLog {
   // A refit's entry (an operator's `calibctl commit --with-term`): the run
   // whose samples it refitted, whose log it copies; 0 for a run of the robot.
   int refit_of = 0;
+  // A run through given waypoints appended to an earlier run: that run,
+  // whose samples its samples.csv begins with; 0 otherwise.
+  int extends = 0;
   std::vector<RunWaypoint> waypoints;
   std::vector<RunFault> faults;
 };

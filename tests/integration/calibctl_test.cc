@@ -103,6 +103,8 @@ class StubDaemon {
     auto server = daemon::ControlServer::listen(socket, [](std::string_view line) -> std::string {
       if (line == "status") return std::string(kStatus) + "\n";
       if (line == "show") return show_response();
+      // The request as the daemon received it (the test's paths need no JSON escapes).
+      if (line.starts_with("start waypoints ")) return "{\"ok\":true,\"message\":\"" + std::string(line) + "\"}\n";
       return "{\"ok\":false,\"error\":\"abort ignored: no calibration running\"}\n";
     });
     EXPECT_TRUE(server.ok()) << server.status().to_string();
@@ -242,6 +244,25 @@ TEST(Calibctl, APermissionErrorNamesTheGroupNotAMissingDaemon) {
   const Outcome hidden = dir.calibctl({"--socket", inner + "/control", "status"}, kNobody);
   EXPECT_EQ(hidden.exit_status, 2);
   EXPECT_TRUE(contains(hidden.err, "permission denied: its directory is closed to you")) << hidden.err;
+}
+
+TEST(Calibctl, StartWithWaypointsSendsTheFilesAbsolutePathAndTheRun) {
+  // GIVEN a daemon's control socket
+  OpenDir dir;
+  const std::string socket = dir.path + "/control";
+  StubDaemon daemon(socket);
+  // WHEN started with a relative waypoints path and a run to append to
+  const Outcome outcome = dir.calibctl({"--socket", socket, "start", "--waypoints", "d/waypoints.csv", "--append-to",
+                                        "run-000007"});
+  // THEN the daemon gets the path made absolute (it does not share calibctl's directory) and the run
+  EXPECT_EQ(outcome.exit_status, 0) << outcome.err;
+  EXPECT_EQ(outcome.out, "start waypoints " + std::filesystem::current_path().string() +
+                             "/d/waypoints.csv run-000007\n");
+  // AND a path the request cannot carry (a blank) is refused by calibctl, exit 1; --append-to alone is an error
+  const Outcome blank = dir.calibctl({"--socket", socket, "start", "--waypoints", "/srv/my waypoints.csv"});
+  EXPECT_EQ(blank.exit_status, 1);
+  EXPECT_TRUE(contains(blank.err, "the path must not contain blanks")) << blank.err;
+  EXPECT_NE(dir.calibctl({"--socket", socket, "start", "--append-to", "7"}).exit_status, 0);
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
-// calibctl: the operator's client of cdpr-calibd's control socket. Starts and
-// aborts a field calibration, shows its progress, the current calibration,
-// the stored versions, rolls back to one of them, retries a commit that
+// calibctl: the operator's client of cdpr-calibd's control socket. Starts
+// (planned, or through a waypoints file) and aborts a field calibration,
+// shows its progress, the current calibration, the stored versions, rolls back to one of them, retries a commit that
 // failed, and commits a kept run refitted with an extra model term.
 //
 // Exit status: 0 done; 1 the daemon refused the request (or, with
@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <thread>
 
@@ -36,7 +37,27 @@ struct Options {
   bool report_path = false;
   std::string with_term;  // commit --with-term
   std::string run;        // its run: 7 or run-000007; empty: the newest
+  std::string waypoints;  // start --waypoints
+  std::string append_to;  // start --append-to RUN
 };
+
+// `start` or `start waypoints <absolute path> [<run>]` (src/control/control_request.h):
+// the daemon does not share the client's working directory. Empty with
+// `error` set when the path cannot be sent (a blank or control byte in it).
+std::string start_request(const Options& options, std::string& error) {
+  if (options.waypoints.empty()) return "start";
+  std::error_code ignored;
+  std::filesystem::path path = std::filesystem::absolute(options.waypoints, ignored);
+  const std::string text = path.lexically_normal().string();
+  for (const char c : text) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    if (u <= 0x20 || u >= 0x7f) {
+      error = "--waypoints " + options.waypoints + ": the path must not contain blanks or non-ASCII bytes";
+      return {};
+    }
+  }
+  return "start waypoints " + text + (options.append_to.empty() ? "" : " " + options.append_to);
+}
 
 // A failure: on stderr for the operator and, with --json, on stdout as one
 // JSON object ({"ok":false,"error":...}, the daemon's own when it refused),
@@ -134,6 +155,13 @@ int main(int argc, char** argv) {
   app.fallthrough();
   auto* start = app.add_subcommand("start", "start a field calibration (as the button does)");
   start->add_flag("--follow,-f", options.follow, "then show progress until the run ends");
+  start->add_option("--waypoints", options.waypoints,
+                    "drive exactly the waypoints of this waypoints.csv (as cdpr-calib diagnose writes it) "
+                    "instead of a plan; the daemon reads the file and checks every waypoint first");
+  start->add_option("--append-to", options.append_to,
+                    "with --waypoints: the run's data are this kept run's samples (7 or run-000007) followed by "
+                    "the new poses, so that diagnose sees them together")
+      ->needs("--waypoints");
   app.add_subcommand("abort", "abort the calibration in progress (winches halted, old calibration kept)");
   auto* status = app.add_subcommand("status", "state, waypoint k/N, progress and reasons");
   status->add_flag("--follow,-f", options.follow, "show progress until the run ends (exit 1 if it fails)");
@@ -171,6 +199,11 @@ int main(int argc, char** argv) {
   }
   const bool refit = command == "commit" && !options.with_term.empty();
   std::string request = command == "rollback" ? "rollback " + std::to_string(options.seq) : command;
+  if (command == "start") request = start_request(options, error);
+  if (request.empty()) {
+    report_failure(options.json, error);
+    return kExitRefused;
+  }
   if (refit) request = "refit " + options.with_term + (options.run.empty() ? "" : " " + options.run);
   int exit_code = 0;
   if (command == "status" && options.follow) return follow(client, options);

@@ -44,11 +44,11 @@ TEST(ControlRequest, RefitNamesItsTermsAndOptionallyItsRun) {
 TEST(ControlRequest, MistakesAreRefusedWithAReason) {
   // GIVEN malformed requests WHEN parsed THEN each error says what is wrong
   EXPECT_EQ(parse_request("strat").error(),
-            "unknown command 'strat' (expected start, abort, status, show, history, rollback <seq>, "
-            "commit, reset-faults or refit <terms> [<run>])");
+            "unknown command 'strat' (expected start [waypoints <path> [<run>]], abort, status, show, history, "
+            "rollback <seq>, commit, reset-faults or refit <terms> [<run>])");
   EXPECT_EQ(parse_request("").error().substr(0, 13), "empty request");
   EXPECT_EQ(parse_request("START").error().substr(0, 15), "unknown command");
-  EXPECT_EQ(parse_request("start now").error(), "start takes no argument");
+  EXPECT_EQ(parse_request("start now").error(), "start takes no argument or: waypoints <path> [<run>]");
   EXPECT_EQ(parse_request("rollback").error(), "rollback takes one argument: <seq>");
   EXPECT_EQ(parse_request("rollback 0").error(), "sequence number '0' is not an integer in 1..999999999");
   EXPECT_FALSE(parse_request("rollback -3"));

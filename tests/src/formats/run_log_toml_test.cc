@@ -24,6 +24,7 @@ RunLog example_log() {
   log.skipped = 2;
   log.calibration = 3;
   log.diagnosis = "model explains the data";
+  log.extends = 6;
   log.waypoints.push_back({1, "sampled", 20.5, 0, "re-solve with 11 samples failed: next waypoint in spread order"});
   log.waypoints.push_back({2, "skipped", 85.0, -1, "no equilibrium within 60 s (platform moving: 4.1 mm/s)"});
   log.faults.push_back({90.0, "winch 2: \"heartbeat\" lost"});
@@ -43,6 +44,7 @@ TEST(RunLogToml, WhatIsWrittenReadsBackTheSame) {
   EXPECT_EQ(parsed->calibration, 3);
   EXPECT_EQ(parsed->diagnosis, log.diagnosis);
   EXPECT_EQ(parsed->strategy, "sequential");
+  EXPECT_EQ(parsed->extends, 6);
   EXPECT_EQ(parsed->stop, "target reached");
   ASSERT_EQ(parsed->waypoints.size(), 2u);
   EXPECT_EQ(parsed->waypoints[0].why, log.waypoints[0].why);
