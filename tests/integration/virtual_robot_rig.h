@@ -19,6 +19,7 @@
 #include "calibctl/control_client.h"
 #include "calibctl/json_value.h"
 #include "drivers/can/canopen_winch_bank.h"
+#include "drivers/can/listening_winch_bank.h"
 #include "drivers/common/load_cell_reader.h"
 #include "drivers/modbus/modbus_load_cell.h"
 #include "drivers/pose/pose_stream_source.h"
@@ -164,7 +165,7 @@ class VirtualRobotRig {
  public:
   // `before_start` runs once the robot is up, the configuration made and the
   // store open, before the drivers and the daemon are built from them (to
-  // change the configuration or commit a previous calibration).
+  // change the configuration, commit a previous calibration or set daemon_log).
   explicit VirtualRobotRig(virtual_robot::VirtualRobotOptions options,
                            const std::function<void(VirtualRobotRig&)>& before_start = {}) {
     char pattern[] = "/tmp/cdpr-integration-XXXXXX";
@@ -181,8 +182,14 @@ class VirtualRobotRig {
     store = std::make_unique<store::CalibrationStore>(config.store);
     EXPECT_TRUE(store->open());
     if (before_start) before_start(*this);
-    winches = std::make_unique<drivers::can::CanopenWinchBank>(
-        config.winches, drivers::can::make_can_connector(config.winches.endpoint));
+    // As main() does: in watch mode the listen-only bank, which cannot send.
+    if (config.operation.watch) {
+      winches = std::make_unique<drivers::can::ListeningWinchBank>(
+          config.winches, config.operation.listen, drivers::can::make_can_connector(config.winches.endpoint));
+    } else {
+      winches = std::make_unique<drivers::can::CanopenWinchBank>(
+          config.winches, drivers::can::make_can_connector(config.winches.endpoint));
+    }
     // The daemon runs on the robot's clock, as cdpr-calibd --sim-clock does:
     // a robot thread starved of CPU is a slower robot, not a device fault.
     const hal::Clock& clock = robot->clock();
@@ -194,7 +201,7 @@ class VirtualRobotRig {
     pose = std::make_unique<drivers::pose::PoseStreamSource>(config.pose.endpoint, clock);
     loop = std::make_unique<daemon::DaemonLoop>(config, robot->nominal_robot(),
                                                 daemon::DaemonDevices{*winches, *load_cell_reader, *pose, nullptr}, *store,
-                                                clock, notifier, nullptr);
+                                                clock, notifier, daemon_log);
     const hal::Status started = loop->start();
     EXPECT_TRUE(started.ok()) << started.to_string();
     loop_thread = std::thread([this] { loop->run(stop_loop); });
@@ -227,7 +234,8 @@ class VirtualRobotRig {
   std::atomic<bool> stop_robot{false};
   std::thread robot_thread;
   daemon::DaemonConfig config;
-  std::unique_ptr<drivers::can::CanopenWinchBank> winches;
+  std::unique_ptr<hal::WinchBank> winches;  // CANopen master, or the listener in watch mode
+  std::function<void(const std::string&)> daemon_log;  // the daemon's log lines (none: not shown)
   std::unique_ptr<drivers::modbus::ModbusLoadCell> load_cell;
   std::unique_ptr<drivers::LoadCellReader> load_cell_reader;  // what the daemon reads, as in main()
   std::unique_ptr<drivers::pose::PoseStreamSource> pose;
