@@ -79,6 +79,7 @@ class VirtualRobotProcess {
   }
   ~VirtualRobotProcess() {
     robot_->signal(SIGTERM);
+    robot_->signal(SIGCONT);  // a test that ended with the robot starved
     robot_->wait_exit(slowed(std::chrono::seconds(30)));
     if (!::testing::Test::HasFailure()) {
       std::filesystem::remove_all(dir);
