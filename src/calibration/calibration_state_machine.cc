@@ -12,6 +12,13 @@ namespace {
 
 std::string seconds(hal::TimeUs duration_us) { return significant(1e-6 * static_cast<double>(duration_us), 3) + " s"; }
 
+// The equilibrium detector's verdict and figures, for the status line.
+std::string rest_detail(const EquilibriumCheck& check) {
+  return std::string(to_string(check.verdict)) + ": speed " + significant(1e3 * check.speed_mps, 3) + " mm/s, rate " +
+         significant(1e3 * check.angular_rate_radps, 3) + " mrad/s, tension std " + significant(check.tension_std_n, 3) +
+         " N, " + std::to_string(check.samples) + " poses";
+}
+
 // At a waypoint (moving to it, settling, sampling): the drives were enabled
 // before the first move and stay so until the run ends.
 bool at_waypoint(CalibrationState state) {
@@ -376,8 +383,8 @@ void CalibrationStateMachine::run_plan(hal::TimeUs now_us) {
   // after_plan() sent the enable.
   if (enable_sent_us_) return enable_drives(now_us);
   const Readings& readings = monitor_.readings();
-  const Eigen::Vector3d start_world(readings.pose->platform_world.x, readings.pose->platform_world.y,
-                                    readings.pose->platform_world.z);
+  Eigen::Vector3d start_world(readings.pose->platform_world.x, readings.pose->platform_world.y,
+                              readings.pose->platform_world.z);
   Robot planning_robot = robot_;
   std::array<double, kCableCount> offsets_m{};
   const bool use_previous = previous_ && previous_->calibration.winches.size() == robot_.winches.size();
@@ -388,9 +395,12 @@ void CalibrationStateMachine::run_plan(hal::TimeUs now_us) {
       offsets_m[i] = previous_->calibration.winches[i].offset_m;
     }
   } else {
-    std::array<double, kCableCount> encoder_m{};
-    for (int i = 0; i < kCableCount; ++i) encoder_m[i] = readings.winches[i].payout_m;
-    const auto estimated = estimate_payout_offsets(robot_, start_world, encoder_m);
+    // Every target carries the estimate's error: the mean of a rest window,
+    // not one pose and encoder reading (docs/calibration.md).
+    const std::optional<Sample> rest = start_rest(now_us);
+    if (!rest) return;
+    start_world = rest->position_world;
+    const auto estimated = estimate_payout_offsets(robot_, start_world, rest->encoder_m);
     if (!estimated) return fail("plan: " + estimated.error(), now_us, false);
     offsets_m = *estimated;
   }
@@ -413,6 +423,43 @@ void CalibrationStateMachine::run_plan(hal::TimeUs now_us) {
               return waypoints.start(planning_robot, offsets_m, start_world, planner, strategy, sequential, now_us);
             },
             now_us);
+}
+
+std::optional<Sample> CalibrationStateMachine::start_rest(hal::TimeUs now_us) {
+  observe_rest();
+  const EquilibriumCheck check = detector_.check();
+  const EquilibriumThresholds& limits = detector_.thresholds();
+  // The drives are off: the platform is still unless it swings from before
+  // (a run stopped mid-move). The rest window's rates suffice; the return
+  // window would cost every first run its length in robot time.
+  const bool still = check.settled() || (check.covered && check.speed_mps <= limits.max_speed_mps &&
+                                         check.angular_rate_radps <= limits.max_angular_rate_radps);
+  if (still) return detector_.average();
+  status_.detail = "measuring the start pose: " + rest_detail(check);
+  if (now_us - status_.state_entered_us <= options_.settle_timeout_us) return std::nullopt;
+  if (detector_.size() == 0) {
+    fail("plan: no pose at the start within " + seconds(options_.settle_timeout_us), now_us, false);
+    return std::nullopt;
+  }
+  status_.note = "start pose not at rest within " + seconds(options_.settle_timeout_us) + " (" + status_.detail +
+                 "): offsets estimated from the window's mean";
+  return detector_.average();
+}
+
+void CalibrationStateMachine::observe_rest() {
+  const Readings& readings = monitor_.readings();
+  if (!readings.pose_is_new || !readings.tension) return;
+  EquilibriumObservation o;
+  // The source's stamp: rates are the platform's (equilibrium_detector.h).
+  o.time_us = readings.pose->source_time_us;
+  o.position_world = Eigen::Vector3d(readings.pose->platform_world.x, readings.pose->platform_world.y,
+                                     readings.pose->platform_world.z);
+  const hal::Quaternion& q = readings.pose->world_R_platform;
+  o.world_R_platform = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized();
+  for (int i = 0; i < kCableCount; ++i) o.encoder_m[i] = readings.winches[i].payout_m;
+  o.tension_n = readings.tension->tension_n;
+  o.tension_stable = readings.tension->stable;
+  detector_.add(o);
 }
 
 void CalibrationStateMachine::after_plan(const std::string& problem, hal::TimeUs now_us) {
@@ -446,28 +493,13 @@ void CalibrationStateMachine::run_move(hal::TimeUs now_us) {
 }
 
 void CalibrationStateMachine::run_settle(hal::TimeUs now_us) {
-  const Readings& readings = monitor_.readings();
-  if (readings.pose_is_new && readings.tension) {
-    EquilibriumObservation o;
-    // The source's stamp: rates are the platform's (equilibrium_detector.h).
-    o.time_us = readings.pose->source_time_us;
-    o.position_world = Eigen::Vector3d(readings.pose->platform_world.x, readings.pose->platform_world.y,
-                                       readings.pose->platform_world.z);
-    const hal::Quaternion& q = readings.pose->world_R_platform;
-    o.world_R_platform = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized();
-    for (int i = 0; i < kCableCount; ++i) o.encoder_m[i] = readings.winches[i].payout_m;
-    o.tension_n = readings.tension->tension_n;
-    o.tension_stable = readings.tension->stable;
-    detector_.add(o);
-  }
+  observe_rest();
   const EquilibriumCheck check = detector_.check();
   if (check.settled()) {
     enter(CalibrationState::kSample, now_us);
     return;
   }
-  status_.detail = std::string(to_string(check.verdict)) + ": speed " + significant(1e3 * check.speed_mps, 3) +
-                   " mm/s, rate " + significant(1e3 * check.angular_rate_radps, 3) + " mrad/s, tension std " +
-                   significant(check.tension_std_n, 3) + " N, " + std::to_string(check.samples) + " poses";
+  status_.detail = rest_detail(check);
   if (now_us - status_.state_entered_us > options_.settle_timeout_us) {
     ++status_.skipped;
     status_.note = "waypoint " + std::to_string(status_.waypoint) + " skipped: no equilibrium within " +

@@ -20,7 +20,10 @@
 //            and the encoder payouts, which the devices report with the
 //            drives disabled. Encoder offsets for the payout targets: the
 //            current calibration's, else estimated at the start pose
-//            (waypoint_planner.h). Then the drives are enabled and the
+//            (waypoint_planner.h) from the mean of the detector's rest
+//            window once it is covered and still (status().detail
+//            "measuring the start pose"; after settle_timeout_us the
+//            window's mean, noted). Then the drives are enabled and the
 //            machine waits for operation enabled (enable_timeout_us;
 //            "enabling drives"). Enabled only once the plan exists: no drive
 //            holds torque while the plan is worked out or when there is none,
@@ -244,6 +247,13 @@ class CalibrationStateMachine {
   void refresh_nodes();
   void run_preflight(hal::TimeUs now_us);
   void run_plan(hal::TimeUs now_us);
+  // The mean pose and encoders of the platform at rest before the first
+  // move, for the offset estimate without a previous calibration: once the
+  // rest window is covered and still (or settled), or after
+  // settle_timeout_us with a note; nullopt while gathering (or failed).
+  std::optional<Sample> start_rest(hal::TimeUs now_us);
+  // Adds the current readings to the detector when a new pose came in.
+  void observe_rest();
   // Commands the drives on, then waits for them (enable_timeout_us) and moves on.
   void enable_drives(hal::TimeUs now_us);
   void run_move(hal::TimeUs now_us);

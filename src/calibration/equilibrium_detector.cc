@@ -169,6 +169,7 @@ EquilibriumCheck EquilibriumDetector::check() const {
                        result.samples >= std::max(thresholds_.min_samples, kRateBins) && bins_filled;
   const bool slow = result.speed_mps <= thresholds_.max_speed_mps &&
                     result.angular_rate_radps <= thresholds_.max_angular_rate_radps;
+  result.covered = covered;
   ReturnTest returned;
   if (covered && slow) returned = return_beyond_noise(begin, std::min(span / kRateBins, 1e6 * kMaxReturnBinS));
   result.return_m = returned.excess_m;

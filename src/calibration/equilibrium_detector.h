@@ -170,6 +170,7 @@ inline double expected_settle_s(const EquilibriumThresholds& t) {
 struct EquilibriumCheck {
   EquilibriumVerdict verdict = EquilibriumVerdict::kNotEnoughData;
   int samples = 0;
+  bool covered = false;              // the rest window: span, min_samples, every rate bin
   hal::TimeUs span_us = 0;           // newest - oldest observation time
   double speed_mps = 0.0;            // measured as described above, noise allowance taken off
   double angular_rate_radps = 0.0;

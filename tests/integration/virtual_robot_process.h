@@ -8,6 +8,7 @@
 // may dip below the planner's 2 N while the small platform swings between
 // waypoints).
 
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -15,6 +16,7 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "calibctl/control_client.h"
@@ -77,6 +79,7 @@ class VirtualRobotProcess {
   }
   ~VirtualRobotProcess() {
     robot_->signal(SIGTERM);
+    robot_->signal(SIGCONT);  // a test that ended with the robot starved
     robot_->wait_exit(slowed(std::chrono::seconds(30)));
     if (!::testing::Test::HasFailure()) {
       std::filesystem::remove_all(dir);
@@ -104,6 +107,37 @@ class VirtualRobotProcess {
     return value ? *value : calibctl::JsonValue{};
   }
   bool answers() const { return ask("status")["ok"].boolean(); }
+  // The virtual robot stops being scheduled (SIGSTOP) or runs again
+  // (SIGCONT): a robot starved of CPU, whose clock stands still meanwhile.
+  void starve_robot(bool starved) { robot_->signal(starved ? SIGSTOP : SIGCONT); }
+  // While it lives, the virtual robot gets 2 ms of every 20 ms of the wall
+  // clock, as on a machine whose cores are taken by others: its clock runs
+  // at a tenth of its speed or less.
+  class StarvedRobot {
+   public:
+    explicit StarvedRobot(VirtualRobotProcess& rig) : rig_(rig), thread_([this] { starve(); }) {}
+    ~StarvedRobot() {
+      done_ = true;
+      thread_.join();
+      rig_.starve_robot(false);
+    }
+    StarvedRobot(const StarvedRobot&) = delete;
+    StarvedRobot& operator=(const StarvedRobot&) = delete;
+
+   private:
+    void starve() {
+      using namespace std::chrono_literals;
+      while (!done_) {
+        rig_.starve_robot(true);
+        std::this_thread::sleep_for(18ms);
+        rig_.starve_robot(false);
+        std::this_thread::sleep_for(2ms);
+      }
+    }
+    VirtualRobotProcess& rig_;
+    std::atomic<bool> done_{false};
+    std::thread thread_;
+  };
   // The virtual robot's clock (its <endpoints>/clock), which the daemons run on.
   const hal::Clock& robot_clock() const { return *robot_clock_; }
   // wait_until() in the robot's time (robot_time.h).

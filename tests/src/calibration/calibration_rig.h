@@ -73,11 +73,14 @@ inline CalibrationResult good_fit(const Robot& robot, const std::vector<Sample>&
 
 class CalibrationRig {
  public:
-  explicit CalibrationRig(CalibratorOptions options = rig_options())
+  // Without `stored_calibration` the store is empty: a robot's first run.
+  explicit CalibrationRig(CalibratorOptions options = rig_options(), bool stored_calibration = true)
       : winches(fast_winches()), load_cell(clock), pose(clock), store({state_dir.path(), 5}) {
     EXPECT_TRUE(store.open());
-    EXPECT_TRUE(store.commit(previous_calibration(robot)));
-    previous_bytes = store::test::file_bytes(store.current_path());
+    if (stored_calibration) {
+      EXPECT_TRUE(store.commit(previous_calibration(robot)));
+      previous_bytes = store::test::file_bytes(store.current_path());
+    }
     EXPECT_TRUE(winches.open().ok());
     EXPECT_TRUE(load_cell.open().ok());
     EXPECT_TRUE(pose.open().ok());
