@@ -1,13 +1,11 @@
 #include "src/daemon/run_refitter.h"
 
 #include <chrono>
-#include <filesystem>
 #include <utility>
 
 #include "solver/model/effects.h"
-#include "src/formats/robot_toml.h"
-#include "src/formats/samples_csv.h"
 #include "src/report/sections.h"
+#include "src/store/kept_run.h"
 
 namespace cdpr::daemon {
 namespace {
@@ -68,30 +66,11 @@ Expected<std::string, std::string> RunRefitter::start_refit(int run, const std::
   if (fitting_) return Unexpected{"a refit of " + status_->run + " is already running"};
   const auto effects = parse_terms(terms);
   if (!effects) return Unexpected{effects.error()};
-  const std::optional<store::RunEntry> entry = history_.find(run);
-  if (!entry) {
-    if (run == 0) return Unexpected{"no run is kept in " + history_.dir()};
-    return Unexpected{"no such run: " + store::RunHistory::entry_name(run) + " is not in " + history_.dir()};
-  }
-  const std::string name = store::RunHistory::entry_name(entry->run);
-  if (!entry->valid) return Unexpected{name + " cannot be refitted: its log is unreadable: " + entry->problem};
-  const std::string samples_path = entry->path + "/" + store::RunHistory::kSamplesName;
-  std::error_code error;
-  if (!std::filesystem::exists(samples_path, error)) {
-    return Unexpected{name + " kept no samples (it ended before its first waypoint)"};
-  }
-  const auto robot = formats::read_robot_toml(entry->path + "/" + store::RunHistory::kRobotName);
-  if (!robot) return Unexpected{name + " cannot be refitted: " + robot.error().message()};
-  if (robot->name != robot_.name) {
-    return Unexpected{name + " was measured on robot '" + robot->name + "', this daemon calibrates '" +
-                      robot_.name + "'"};
-  }
-  auto samples = formats::read_samples_csv(samples_path, robot->cable_count());
-  if (!samples) return Unexpected{name + " cannot be refitted: " + samples.error().message()};
-  if (samples->empty()) return Unexpected{name + " has no samples to refit"};
-
-  job_ = CommittedRefit{entry->log, *robot, std::move(*samples), fit_options_, {}, 0, terms};
-  job_.source_log.run = entry->run;
+  auto kept = store::read_kept_run(history_, run, robot_.name, "refitted");
+  if (!kept) return Unexpected{kept.error()};
+  const std::string name = store::RunHistory::entry_name(kept->entry.run);
+  job_ = CommittedRefit{kept->entry.log, std::move(kept->robot), std::move(kept->samples), fit_options_, {}, 0, terms};
+  job_.source_log.run = kept->entry.run;
   job_.options.cable_model = CableModelKind::kCatenary;
   job_.options.effects = *effects;
   committed_.reset();
